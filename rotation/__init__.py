@@ -1,0 +1,13 @@
+"""Robust frame-to-frame camera rotation from optical flow (no video involved).
+
+Conventions (axes, flow layout, R_t) are those of CONVENTIONS.md:
+p_{t+1} ~ K R_t K⁻¹ p_t for static points at infinity.
+
+>>> from rotation import HoughEstimator, estimate, RotationEstimate
+"""
+
+from rotation import baselines, camera, so3
+from rotation.hough import HoughEstimator, estimate
+from rotation.result import RotationEstimate
+
+__all__ = ["HoughEstimator", "RotationEstimate", "baselines", "camera", "estimate", "so3"]
