@@ -1,0 +1,82 @@
+"""Encoding frames with FFmpeg through a pipe (driven with ffmpeg-python)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import ffmpeg
+import numpy as np
+from numpy.typing import NDArray
+
+from stabilize.ffmpeg_tools import ffmpeg_exe
+
+
+@dataclass(frozen=True)
+class Encoding:
+    codec: str = "libx264"
+    crf: int = 18
+    preset: str = "medium"
+    pix_fmt: str = "yuv420p"
+
+
+class FrameWriter:
+    """Streams RGB uint8 frames into an encoder process.
+
+    Constant frame rate ``fps``; an optional extra input (e.g. an audio source given
+    as ffmpeg-python stream) is muxed in and cut to the video's length.
+    """
+
+    def __init__(
+        self,
+        path: str | Path,
+        size: tuple[int, int],
+        fps: float,
+        encoding: Encoding = Encoding(),
+        audio=None,
+    ) -> None:
+        h, w = size
+        self.size = size
+        video = ffmpeg.input("pipe:", format="rawvideo", pix_fmt="rgb24", s=f"{w}x{h}",
+                             framerate=fps)  # fmt: skip
+        streams = [video] if audio is None else [video, audio]
+        options = {"vcodec": encoding.codec, "crf": encoding.crf, "preset": encoding.preset,
+                   "pix_fmt": encoding.pix_fmt, "format": "mp4", "movflags": "+faststart"}  # fmt: skip
+        if audio is not None:
+            options.update(acodec="aac", shortest=None)
+        self._process = (
+            ffmpeg.output(*streams, str(path), **options)
+            .global_args("-hide_banner", "-loglevel", "error", "-nostdin")
+            .overwrite_output()
+            .run_async(cmd=ffmpeg_exe(), pipe_stdin=True, pipe_stderr=True)
+        )
+
+    def write(self, frame: NDArray[np.uint8]) -> None:
+        if frame.shape[:2] != self.size or frame.dtype != np.uint8:
+            raise ValueError(f"frame must be uint8 {self.size}, got {frame.dtype} {frame.shape}")
+        self._process.stdin.write(np.ascontiguousarray(frame).tobytes())
+
+    def close(self) -> None:
+        self._process.stdin.close()
+        err = self._process.stderr.read().decode(errors="replace")
+        if self._process.wait() != 0:
+            raise RuntimeError(f"ffmpeg failed: {err.strip().splitlines()[-1] if err else '?'}")
+
+    def __enter__(self) -> FrameWriter:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self._process.kill()
+            self._process.wait()
+
+
+def sine_audio(seconds: float, frequency: float = 440.0):
+    """A test tone as an ffmpeg-python input (lavfi), for clips that must carry audio."""
+    return ffmpeg.input(f"sine=frequency={frequency}:duration={seconds:.3f}:sample_rate=48000",
+                        format="lavfi").audio  # fmt: skip
+
+
+__all__ = ["Encoding", "FrameWriter", "sine_audio"]
