@@ -31,8 +31,9 @@ def clips(n_frames: int, seeds: list[int]):
 
     out = []
     for seed in seeds:
-        opts = SynthOptions(seed=seed, seconds=n_frames / 30.0, size=SIZE, crowd=12,
-                            shake_deg=1.0, walk=1.2)  # fmt: skip
+        opts = SynthOptions(
+            seed=seed, seconds=n_frames / 30.0, size=SIZE, crowd=12, shake_deg=1.0, walk=1.2
+        )
         frames, flows = zip(*render_frames(opts, with_flow=True), strict=True)
         times = np.arange(opts.n_frames) / opts.fps
         R = trajectory.relative_rotations(opts.motion, times)
@@ -90,8 +91,13 @@ def main() -> None:
     runs = [("dis", {"preset": p}, f"dis ({p})") for p in ("ultrafast", "fast", "medium")]
     if weights:
         for iters in (12, 20):
-            runs.append(("raft", {"weights": str(weights), "iters": iters, "device": "cpu"},
-                         f"raft small, {iters} it (cpu)"))  # fmt: skip
+            runs.append(
+                (
+                    "raft",
+                    {"weights": str(weights), "iters": iters, "device": "cpu"},
+                    f"raft small, {iters} it (cpu)",
+                )
+            )
     else:
         print("(no RAFT weights found: pass --raft-weights or set STABILIZE_RAFT_WEIGHTS)")
 
@@ -105,8 +111,10 @@ def main() -> None:
         ms, epe, rot, peak = queue.get()
         proc.join()
         print(f"{label:28s}{ms:10.1f}{epe:10.3f}{rot:12.4f}{peak:10.0f}")
-    print(f"{'exact flow (reference)':28s}{'':10s}{0.0:10.3f}"
-          f"{exact_flow_rotation_error(args.frames, seeds):12.4f}")  # fmt: skip
+    print(
+        f"{'exact flow (reference)':28s}{'':10s}{0.0:10.3f}"
+        f"{exact_flow_rotation_error(args.frames, seeds):12.4f}"
+    )
 
 
 if __name__ == "__main__":

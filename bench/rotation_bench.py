@@ -90,8 +90,10 @@ def main() -> None:
     street = make_set("street", n, seed=args.seed, min_deg=10.0, max_deg=10.0)
     wide = HoughEstimator(SIZE, FOCAL, max_deg=15.0)
     (ms_p, err_p), (ms_s, err_s) = run(wide.estimate, fast), run(wide.estimate, street)
-    print(f"\n10° per frame, max_deg=15: pure {ms_p:.2f} ms / {err_p:.4f}°, "
-          f"street {ms_s:.2f} ms / {err_s:.4f}°")  # fmt: skip
+    print(
+        f"\n10° per frame, max_deg=15: pure {ms_p:.2f} ms / {err_p:.4f}°, "
+        f"street {ms_s:.2f} ms / {err_s:.4f}°"
+    )
 
     many = make_set("street", 300, seed=args.seed + 7)
     ms, err = run_many(hough, many)

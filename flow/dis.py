@@ -43,8 +43,9 @@ class DISFlow:
             grey = to_grey(check_frame(frame))
             if previous is not None:
                 if grey.shape != previous.shape:
-                    raise ValueError(f"frame sizes differ: {previous.shape[::-1]} and "
-                                     f"{grey.shape[::-1]}")  # fmt: skip
+                    raise ValueError(
+                        f"frame sizes differ: {previous.shape[::-1]} and {grey.shape[::-1]}"
+                    )
                 yield self._flow(previous, grey)
             previous = grey
 

@@ -35,8 +35,10 @@ class WorkingSize:
     def resize(self, frame: NDArray) -> NDArray:
         """Resize a frame of the source size (area averaging when shrinking)."""
         if frame.shape[:2] != self.source:
-            raise ValueError(f"frame is {frame.shape[1]}×{frame.shape[0]}, expected "
-                             f"{self.source[1]}×{self.source[0]}")  # fmt: skip
+            raise ValueError(
+                f"frame is {frame.shape[1]}×{frame.shape[0]}, expected "
+                f"{self.source[1]}×{self.source[0]}"
+            )
         if self.size == self.source:
             return frame
         shrink = self.size[0] < self.source[0]
@@ -63,6 +65,8 @@ def working_size(
     if h < 1 or w < 1:
         raise ValueError(f"frame size must be positive, got {w}×{h}")
     s = 1.0 if long_side is None else min(1.0, long_side / max(h, w))
-    size = (max(multiple, round(h * s / multiple) * multiple),
-            max(multiple, round(w * s / multiple) * multiple))  # fmt: skip
+    size = (
+        max(multiple, round(h * s / multiple) * multiple),
+        max(multiple, round(w * s / multiple) * multiple),
+    )
     return WorkingSize((h, w), size)

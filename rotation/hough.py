@@ -132,9 +132,18 @@ class HoughEstimator:
         u, v, valid = sample_flows(flow, self.grid)
         with self._lock:
             R, count, inliers = estimate_field(
-                self.grid.x, self.grid.y, u, v, valid, self.focal, self.levels,
-                self._model_code, self.refine, self._acc, self._touched,
-            )  # fmt: skip
+                self.grid.x,
+                self.grid.y,
+                u,
+                v,
+                valid,
+                self.focal,
+                self.levels,
+                self._model_code,
+                self.refine,
+                self._acc,
+                self._touched,
+            )
         return self._result(R, count, inliers, valid)
 
     def estimate_many(self, flows: NDArray) -> list[RotationEstimate]:
@@ -142,10 +151,19 @@ class HoughEstimator:
         flows = check_flows(flows, self.size, stacked=True)
         u, v, valid = sample_flows(flows, self.grid)
         Rs, counts, inliers = estimate_batch(
-            self.grid.x, self.grid.y, u, v, valid, self.focal, self.levels,
-            self._model_code, self.refine, self._n_max, self._touched_len,
+            self.grid.x,
+            self.grid.y,
+            u,
+            v,
+            valid,
+            self.focal,
+            self.levels,
+            self._model_code,
+            self.refine,
+            self._n_max,
+            self._touched_len,
             min(len(u), 2 * get_num_threads()),
-        )  # fmt: skip
+        )
         return [self._result(*item) for item in zip(Rs, counts, inliers, valid, strict=True)]
 
     def _result(self, R: NDArray, count: int, inliers: NDArray, valid: NDArray) -> RotationEstimate:

@@ -84,9 +84,15 @@ def lh_segment(a0: float, b0: float, da: float, db: float, n: int) -> tuple:
 
 @njit(cache=True)
 def vote_lh_line(
-    a0: float, b0: float, da: float, db: float, n: int,
-    acc: np.ndarray, touched: np.ndarray, state: np.ndarray,
-) -> None:  # fmt: skip
+    a0: float,
+    b0: float,
+    da: float,
+    db: float,
+    n: int,
+    acc: np.ndarray,
+    touched: np.ndarray,
+    state: np.ndarray,
+) -> None:
     """One vote for every bin the line crosses (3-D DDA walk along the segment)."""
     t0, t1 = lh_segment(a0, b0, da, db, n)
     if not t0 < t1:

@@ -106,7 +106,7 @@ def synth(
     ),
     procedural: bool = typer.Option(
         False, help="Use the procedural skyline even if the photograph is present."
-    ),  # fmt: skip
+    ),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar."),
 ) -> None:
     """Render a shaky handheld street clip whose every rotation is known, with its gyro log."""
@@ -117,11 +117,20 @@ def synth(
     if bg is not None and not Path(bg).is_file():
         _fail(f"background image not found: {bg}")
     opts = SynthOptions(
-        seed=seed, seconds=seconds, fps=fps, size=_size(size), hfov=hfov, crowd=crowd,
-        walls=walls, shake_deg=shake_deg, pan_deg=pan_deg, walk=walk,
-        rolling_shutter_ms=rolling_shutter_ms, gyro_offset=gyro_offset,
+        seed=seed,
+        seconds=seconds,
+        fps=fps,
+        size=_size(size),
+        hfov=hfov,
+        crowd=crowd,
+        walls=walls,
+        shake_deg=shake_deg,
+        pan_deg=pan_deg,
+        walk=walk,
+        rolling_shutter_ms=rolling_shutter_ms,
+        gyro_offset=gyro_offset,
         background=str(bg) if bg else None,
-    )  # fmt: skip
+    )
     with progress_bar("rendering", opts.n_frames, unit="frames", quiet=quiet) as advance:
         summary = render_clip(out_dir, opts, advance)
     typer.echo(json.dumps(summary, indent=2))

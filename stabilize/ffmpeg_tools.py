@@ -36,8 +36,9 @@ def atomic_output(path: str | os.PathLike, *, overwrite: bool = False) -> Iterat
     if final.exists() and not overwrite:
         raise FileExistsError(f"{final} exists (use --overwrite to replace it)")
     final.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{final.stem}.", suffix=f".partial{final.suffix}",
-                               dir=final.parent)  # fmt: skip
+    fd, tmp = tempfile.mkstemp(
+        prefix=f".{final.stem}.", suffix=f".partial{final.suffix}", dir=final.parent
+    )
     os.close(fd)
     tmp_path = Path(tmp)
     try:

@@ -37,11 +37,18 @@ class FrameWriter:
     ) -> None:
         h, w = size
         self.size = size
-        video = ffmpeg.input("pipe:", format="rawvideo", pix_fmt="rgb24", s=f"{w}x{h}",
-                             framerate=fps)  # fmt: skip
+        video = ffmpeg.input(
+            "pipe:", format="rawvideo", pix_fmt="rgb24", s=f"{w}x{h}", framerate=fps
+        )
         streams = [video] if audio is None else [video, audio]
-        options = {"vcodec": encoding.codec, "crf": encoding.crf, "preset": encoding.preset,
-                   "pix_fmt": encoding.pix_fmt, "format": "mp4", "movflags": "+faststart"}  # fmt: skip
+        options = {
+            "vcodec": encoding.codec,
+            "crf": encoding.crf,
+            "preset": encoding.preset,
+            "pix_fmt": encoding.pix_fmt,
+            "format": "mp4",
+            "movflags": "+faststart",
+        }
         if audio is not None:
             options.update(acodec="aac", shortest=None)
         self._process = (
@@ -75,8 +82,9 @@ class FrameWriter:
 
 def sine_audio(seconds: float, frequency: float = 440.0):
     """A test tone as an ffmpeg-python input (lavfi), for clips that must carry audio."""
-    return ffmpeg.input(f"sine=frequency={frequency}:duration={seconds:.3f}:sample_rate=48000",
-                        format="lavfi").audio  # fmt: skip
+    return ffmpeg.input(
+        f"sine=frequency={frequency}:duration={seconds:.3f}:sample_rate=48000", format="lavfi"
+    ).audio
 
 
 __all__ = ["Encoding", "FrameWriter", "sine_audio"]

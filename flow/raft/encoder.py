@@ -89,8 +89,9 @@ class Encoder(nn.Module):
         self.relu1 = nn.ReLU(inplace=True)
         layers, in_planes = [], stem
         for width, stride in zip(widths, (1, 2, 2), strict=True):
-            layers.append(nn.Sequential(block(in_planes, width, norm, stride),
-                                        block(width, width, norm, 1)))  # fmt: skip
+            layers.append(
+                nn.Sequential(block(in_planes, width, norm, stride), block(width, width, norm, 1))
+            )
             in_planes = width
         self.layer1, self.layer2, self.layer3 = layers
         self.conv2 = nn.Conv2d(in_planes, output_dim, 1)

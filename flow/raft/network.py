@@ -50,8 +50,9 @@ def normalise(images: torch.Tensor) -> torch.Tensor:
 
 def coords_grid(batch: int, h: int, w: int, device: torch.device) -> torch.Tensor:
     """Pixel coordinates (B, 2, h, w), channel 0 = x (column), 1 = y (row)."""
-    ys, xs = torch.meshgrid(torch.arange(h, device=device), torch.arange(w, device=device),
-                            indexing="ij")  # fmt: skip
+    ys, xs = torch.meshgrid(
+        torch.arange(h, device=device), torch.arange(w, device=device), indexing="ij"
+    )
     return torch.stack([xs, ys], dim=0).float()[None].repeat(batch, 1, 1, 1)
 
 

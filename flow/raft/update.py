@@ -60,8 +60,9 @@ class GRUPlan(NamedTuple):
     padding: tuple[int, int]
 
 
-def plan_gru(convz: nn.Conv2d, convr: nn.Conv2d, convq: nn.Conv2d,
-             hidden: int, inp: torch.Tensor) -> GRUPlan:  # fmt: skip
+def plan_gru(
+    convz: nn.Conv2d, convr: nn.Conv2d, convq: nn.Conv2d, hidden: int, inp: torch.Tensor
+) -> GRUPlan:
     """Split the gates' weights by input block: hidden state, context, motion."""
     ctx = slice(hidden, hidden + inp.shape[1])
     pad = convz.padding
@@ -84,8 +85,9 @@ def plan_gru(convz: nn.Conv2d, convr: nn.Conv2d, convq: nn.Conv2d,
 
 def gru_step(plan: GRUPlan, h: torch.Tensor, motion: torch.Tensor) -> torch.Tensor:
     """h ← (1 - z) h + z q, with z, r gates and candidate q from [h, context, motion]."""
-    zr = torch.sigmoid(F.conv2d(torch.cat([h, motion], dim=1), plan.w_zr, padding=plan.padding)
-                       + plan.zr_const)  # fmt: skip
+    zr = torch.sigmoid(
+        F.conv2d(torch.cat([h, motion], dim=1), plan.w_zr, padding=plan.padding) + plan.zr_const
+    )
     z, r = zr.chunk(2, dim=1)
     q = F.conv2d(torch.cat([r * h, motion], dim=1), plan.w_q, padding=plan.padding)
     q = torch.tanh(q + plan.q_const)

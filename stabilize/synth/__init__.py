@@ -119,8 +119,9 @@ def render_frames(
         if with_flow and k + 1 < opts.n_frames:
             t1 = t + 1.0 / opts.fps
             O1 = trajectory.orientation(opts.motion, t1)
-            flow = ground_truth_flow(hits, K, O1, trajectory.position(opts.motion, t1),
-                                     1.0 / opts.fps)  # fmt: skip
+            flow = ground_truth_flow(
+                hits, K, O1, trajectory.position(opts.motion, t1), 1.0 / opts.fps
+            )
         yield hits.colour, flow
 
 

@@ -121,8 +121,9 @@ def _lookup(tex: NDArray, u: NDArray, v: NDArray, border: int) -> NDArray:
     return got.reshape(rows * 1024, -1)[:n]
 
 
-def _paint(flat: NDArray, idx: NDArray, levels: list[NDArray], u: NDArray, v: NDArray,
-           texels: NDArray) -> None:  # fmt: skip
+def _paint(
+    flat: NDArray, idx: NDArray, levels: list[NDArray], u: NDArray, v: NDArray, texels: NDArray
+) -> None:
     """flat[idx] ← wrapped lookups at texels (u, v), each from the mip level that suits
     its footprint (``texels`` texture pixels per image pixel)."""
     level = _mip_level(texels, len(levels))
@@ -207,14 +208,16 @@ def cast(scene: Scene, rays: NDArray, C: NDArray, c: NDArray, t: NDArray, focal:
             sf = s.ravel()[idx]
             x = o.reshape(-1, 3)[idx // w, 0] + sf * flat_d[idx, 0]
             z = o.reshape(-1, 3)[idx // w, 2] + sf * flat_d[idx, 2]
-            _paint(flat_colour, idx, scene.ground, x * PX_PER_M, z * PX_PER_M,
-                   footprint(idx, sf, 1))  # fmt: skip
+            _paint(
+                flat_colour, idx, scene.ground, x * PX_PER_M, z * PX_PER_M, footprint(idx, sf, 1)
+            )
             depth.ravel()[idx] = sf
 
         # Walls: x = ±half_width, from the ground up to wall_height.
         for side in (-1.0, 1.0) if st.walls else ():
-            s = np.where(side * d[..., 0] > 1e-9, (side * st.half_width - o[..., 0]) / d[..., 0],
-                         np.inf)  # fmt: skip
+            s = np.where(
+                side * d[..., 0] > 1e-9, (side * st.half_width - o[..., 0]) / d[..., 0], np.inf
+            )
             idx = np.flatnonzero(s < depth)
             if not idx.size:
                 continue

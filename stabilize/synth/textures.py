@@ -96,8 +96,11 @@ def _cube_coords(d: NDArray, face: int) -> tuple[NDArray[np.float32], NDArray[np
     # OpenGL cube-map convention, in y-up axes.
     x, y, z = d[..., 0], -d[..., 1], d[..., 2]
     ax, ay, az = np.abs(x), np.abs(y), np.abs(z)
-    index = np.where((ax >= ay) & (ax >= az), np.where(x > 0, 0, 1),
-                     np.where(ay >= az, np.where(y > 0, 2, 3), np.where(z > 0, 4, 5)))  # fmt: skip
+    index = np.where(
+        (ax >= ay) & (ax >= az),
+        np.where(x > 0, 0, 1),
+        np.where(ay >= az, np.where(y > 0, 2, 3), np.where(z > 0, 4, 5)),
+    )
     ma = np.choose(index, [ax, ax, ay, ay, az, az])
     sc = np.choose(index, [-z, z, x, x, x, -x])
     tc = np.choose(index, [-y, -y, z, -z, -y, -y])

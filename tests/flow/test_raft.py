@@ -42,8 +42,10 @@ def test_low_resolution_flow_matches_too(shared, raft):
     folder = shared / "raft" / "case2"
     params = json.loads((folder / "params.json").read_text())
     assert params["model"] == "raft-small"
-    images = [torch.from_numpy(read_rgb(folder / f"frame{k}.png")).permute(2, 0, 1)[None].float()
-              for k in (0, 1)]  # fmt: skip
+    images = [
+        torch.from_numpy(read_rgb(folder / f"frame{k}.png")).permute(2, 0, 1)[None].float()
+        for k in (0, 1)
+    ]
     with torch.inference_mode():
         low, _ = raft.model(*images, iters=20)
     reference = np.load(folder / "flow_lowres_iters20.npy")
@@ -227,9 +229,14 @@ def test_every_official_key_has_a_torchvision_round_trip(variant):
 def test_large_model_runs_and_has_the_official_layout():
     model = RAFT("large").eval()
     keys = set(model.state_dict())
-    for key in ("fnet.layer2.0.downsample.0.weight", "cnet.norm1.running_var",
-                "cnet.layer2.0.norm3.weight", "update_block.gru.convz1.weight",
-                "update_block.encoder.convc2.weight", "update_block.mask.2.bias"):  # fmt: skip
+    for key in (
+        "fnet.layer2.0.downsample.0.weight",
+        "cnet.norm1.running_var",
+        "cnet.layer2.0.norm3.weight",
+        "update_block.gru.convz1.weight",
+        "update_block.encoder.convc2.weight",
+        "update_block.mask.2.bias",
+    ):
         assert key in keys, key
     x = torch.rand(1, 3, 64, 96) * 255
     with torch.inference_mode():

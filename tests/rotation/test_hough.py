@@ -63,8 +63,12 @@ def test_refinement_beats_bin_centres():
     centres = errors(centres, data.rotations)
     assert refined.mean() < 0.6 * centres.mean()
     clean = make_set("pure", 10, seed=6)
-    assert errors(HoughEstimator(SIZE, F, refine=False).estimate_many(clean.flows),
-                  clean.rotations).mean() > 0.005  # fmt: skip
+    assert (
+        errors(
+            HoughEstimator(SIZE, F, refine=False).estimate_many(clean.flows), clean.rotations
+        ).mean()
+        > 0.005
+    )
     # The bin centre is within half a bin diagonal of the truth; refinement is not bound by it.
     assert errors(HoughEstimator(SIZE, F).estimate_many(clean.flows), clean.rotations).max() < 1e-4
 
