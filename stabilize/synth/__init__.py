@@ -70,7 +70,18 @@ class SynthOptions:
 
     @property
     def motion(self) -> Handheld:
-        return Handheld(self.seconds, self.seed, self.shake_deg, self.pan_deg, self.walk)
+        """The camera path. Bob and sway come from walking: with walk=0 the camera only
+        turns, which makes every pixel's flow a pure rotation."""
+        walking = self.walk > 0
+        return Handheld(
+            self.seconds,
+            self.seed,
+            self.shake_deg,
+            self.pan_deg,
+            self.walk,
+            bob_m=0.02 * walking,
+            sway_m=0.015 * walking,
+        )
 
     def K(self) -> NDArray[np.float64]:
         return intrinsics(self.focal, self.size)

@@ -1,0 +1,192 @@
+"""The stabilisation literature's quality metrics, computed the same way for any tool.
+
+* **Cropping ratio**: the mean scale of the registration from each original frame to
+  the stabilised one (1 = nothing cropped; smaller = more zoom).
+* **Distortion**: the worst frame's ratio of the smaller to the larger singular value of
+  that registration's linear part (1 = no anisotropic stretch).
+* **Stability** (Liu et al. 2013): the inter-frame motions of a clip, accumulated into a
+  path; for its translation (mean of x and y) and its rotation, the share of spectral
+  energy in the 2nd–6th FFT components, DC excluded. Higher is steadier. Reported
+  separately and as the minimum of the two.
+* **ITF**: the mean PSNR of consecutive frames, in dB.
+
+Registrations are ORB features matched with a ratio test, then a RANSAC homography;
+frames with too few features fall back to the identity (and are counted).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import asdict, dataclass
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+MIN_MATCHES = 12
+LOW_BAND = slice(1, 6)  # the 2nd to the 6th FFT components (index 0 is DC)
+REGISTRATION_LONG_SIDE = 640
+
+
+def _grey(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY) if frame.ndim == 3 else frame
+    scale = REGISTRATION_LONG_SIDE / max(grey.shape)
+    if scale < 1:
+        grey = cv2.resize(grey, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
+    return grey
+
+
+class Registrar:
+    """Homographies between frames (ORB + ratio test + RANSAC), in the frames' pixels."""
+
+    def __init__(self) -> None:
+        self.orb = cv2.ORB_create(nfeatures=2000, fastThreshold=10)
+        self.matcher = cv2.BFMatcher(cv2.NORM_HAMMING)
+        self.failures = 0
+
+    def features(self, frame: NDArray[np.uint8]):
+        grey = _grey(frame)
+        scale = frame.shape[1] / grey.shape[1]
+        kp, desc = self.orb.detectAndCompute(grey, None)
+        pts = np.float32([k.pt for k in kp]) * scale if kp else np.zeros((0, 2), np.float32)
+        return pts, desc
+
+    def homography(self, a, b) -> NDArray[np.float64]:
+        """H with b ~ H a, from features() of two frames; identity if it cannot be found."""
+        (pa, da), (pb, db) = a, b
+        if da is None or db is None or len(pa) < MIN_MATCHES or len(pb) < MIN_MATCHES:
+            self.failures += 1
+            return np.eye(3)
+        pairs = self.matcher.knnMatch(da, db, k=2)
+        good = [m[0] for m in pairs if len(m) == 2 and m[0].distance < 0.8 * m[1].distance]
+        if len(good) < MIN_MATCHES:
+            self.failures += 1
+            return np.eye(3)
+        src = pa[[m.queryIdx for m in good]]
+        dst = pb[[m.trainIdx for m in good]]
+        H, mask = cv2.findHomography(src, dst, cv2.USAC_MAGSAC, 1.5)
+        if H is None or mask.sum() < MIN_MATCHES:
+            self.failures += 1
+            return np.eye(3)
+        return H / H[2, 2]
+
+
+def jacobian(H: NDArray, point: tuple[float, float]) -> NDArray:
+    """The 2×2 local linear part of the homography H at a pixel."""
+    x, y = point
+    p = H @ [x, y, 1.0]
+    return (H[:2, :2] * p[2] - np.outer(p[:2], H[2, :2])) / p[2] ** 2
+
+
+def scale_and_distortion(
+    H: NDArray, center: tuple[float, float] = (0.0, 0.0)
+) -> tuple[float, float]:
+    """Scale √|det A| and singular-value ratio σ_min/σ_max of A, H's linear part at
+    ``center`` (the image centre: there a fitted homography's small perspective terms
+    do not masquerade as stretch)."""
+    s = np.linalg.svd(jacobian(H, center), compute_uv=False)
+    return float(np.sqrt(s[0] * s[1])), float(s[1] / s[0])
+
+
+STILL_PX = 0.05  # a path that moves less than this (RMS) is perfectly steady
+STILL_RAD = 1e-4
+
+
+def low_frequency_share(signal: NDArray, still: float = 0.0) -> float:
+    """Energy share of the 2nd–6th FFT components of a signal, DC excluded.
+
+    A signal whose RMS about its mean is below ``still`` scores 1: otherwise the
+    registration's numerical noise on a motionless clip would decide its score.
+    """
+    if len(signal) < 8:
+        return float("nan")
+    signal = signal - signal.mean()
+    if np.sqrt(np.mean(signal**2)) < still:
+        return 1.0
+    power = np.abs(np.fft.fft(signal)) ** 2
+    power = power[: len(power) // 2 + 1]
+    total = power[1:].sum()
+    return float(power[LOW_BAND].sum() / total) if total > 0 else 1.0
+
+
+def stability(inter_frame: list[NDArray]) -> tuple[float, float]:
+    """(translation, rotation) stability of a path accumulated from inter-frame homographies."""
+    path = []
+    P = np.eye(3)
+    for H in inter_frame:
+        P = H @ P
+        path.append(P / P[2, 2])
+    path = np.array(path)
+    if len(path) < 8:
+        return float("nan"), float("nan")
+    tx, ty = path[:, 0, 2], path[:, 1, 2]
+    angle = np.unwrap(np.arctan2(path[:, 1, 0], path[:, 0, 0]))
+    translation = 0.5 * (low_frequency_share(tx, STILL_PX) + low_frequency_share(ty, STILL_PX))
+    return translation, low_frequency_share(angle, STILL_RAD)
+
+
+def psnr(a: NDArray[np.uint8], b: NDArray[np.uint8]) -> float:
+    mse = np.mean((a.astype(np.float32) - b.astype(np.float32)) ** 2)
+    return float(10 * np.log10(255.0**2 / mse)) if mse > 0 else 100.0
+
+
+@dataclass(frozen=True)
+class ClipMetrics:
+    frames: int
+    cropping_ratio: float
+    distortion: float
+    stability_translation: float
+    stability_rotation: float
+    stability: float
+    itf_db: float
+    registration_failures: int
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def evaluate(
+    original: Iterable[NDArray[np.uint8]],
+    stabilised: Iterable[NDArray[np.uint8]] | None = None,
+) -> ClipMetrics:
+    """Metrics of ``stabilised`` against ``original`` (or of ``original`` alone).
+
+    Frames are taken in step; if one clip is longer, its extra frames are ignored.
+    For the original alone, cropping ratio and distortion are 1 by definition.
+    """
+    reg = Registrar()
+    scales, ratios, inter, itf = [], [], [], []
+    prev_feat = prev_frame = None
+    n = 0
+    pairs = (
+        ((o, None) for o in original)
+        if stabilised is None
+        else zip(original, stabilised, strict=False)
+    )
+    for orig, stab in pairs:
+        frame = orig if stab is None else stab
+        feat = reg.features(frame)
+        if stab is not None:
+            # Stabilised → original: a zoomed-in output registers with scale < 1.
+            H = reg.homography(feat, reg.features(orig))
+            center = ((frame.shape[1] - 1) / 2, (frame.shape[0] - 1) / 2)
+            scale, ratio = scale_and_distortion(H, center)
+            scales.append(scale)
+            ratios.append(ratio)
+        if prev_feat is not None:
+            inter.append(reg.homography(prev_feat, feat))
+            grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
+            itf.append(psnr(cv2.cvtColor(prev_frame, cv2.COLOR_RGB2GRAY), grey))
+        prev_feat, prev_frame = feat, frame
+        n += 1
+    st, sr = stability(inter)
+    return ClipMetrics(
+        frames=n,
+        cropping_ratio=float(np.mean(scales)) if scales else 1.0,
+        distortion=float(np.min(ratios)) if ratios else 1.0,
+        stability_translation=st,
+        stability_rotation=sr,
+        stability=float(min(st, sr)),
+        itf_db=float(np.mean(itf)) if itf else float("nan"),
+        registration_failures=reg.failures,
+    )

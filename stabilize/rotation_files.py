@@ -1,0 +1,55 @@
+"""Rotation files: one row per frame pair, ``frame,t,rx,ry,rz[,...]`` (R_t as a rotation
+vector in radians, CONVENTIONS.md). ``stabilize rotations`` writes them, with a
+``support`` column; ``stabilize synth``'s ``truth.csv`` has the same leading columns."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rotation import so3
+
+COLUMNS = ("frame", "t", "rx", "ry", "rz")
+
+
+def read_rotations(path: str | Path) -> dict[int, NDArray[np.float64]]:
+    """{frame: rotation vector} for every row that has one."""
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"{path}: no such rotations file")
+    out = {}
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
+        if missing:
+            raise ValueError(f"{path}: missing column(s) {', '.join(missing)}")
+        for line, row in enumerate(reader, start=2):
+            if not row["rx"]:
+                continue  # the last frame of a truth file has no pair
+            try:
+                out[int(row["frame"])] = np.array([float(row[k]) for k in ("rx", "ry", "rz")])
+            except ValueError:
+                raise ValueError(f"{path}:{line}: not a number") from None
+    return out
+
+
+def write_rotations(path: str | Path, times, rotvecs, support) -> None:
+    """``frame,t,rx,ry,rz,support`` for each pair (frame k → k+1)."""
+    with open(path, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow([*COLUMNS, "support"])
+        for k, (t, rv, s) in enumerate(zip(times, rotvecs, support, strict=True)):
+            writer.writerow([k, f"{t:.6f}", *(f"{v:.9g}" for v in rv), f"{s:.4f}"])
+
+
+def angular_errors(estimate: dict, truth: dict) -> NDArray[np.float64]:
+    """θ(R̂ Rᵀ) in degrees for the frames present in both."""
+    common = sorted(set(estimate) & set(truth))
+    if not common:
+        raise ValueError("the rotations and the truth share no frame")
+    R_hat = so3.exp_so3(np.array([estimate[k] for k in common]))
+    R = so3.exp_so3(np.array([truth[k] for k in common]))
+    return so3.angular_error_deg(R_hat, R)

@@ -1,0 +1,113 @@
+"""Decoding video with FFmpeg through a pipe (driven with ffmpeg-python).
+
+Probing parses what ``ffmpeg -i`` reports, since the bundled FFmpeg of imageio-ffmpeg
+comes without ffprobe.
+"""
+
+from __future__ import annotations
+
+import re
+import subprocess
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import ffmpeg
+import numpy as np
+from numpy.typing import NDArray
+
+from stabilize.ffmpeg_tools import ffmpeg_exe
+
+
+class VideoError(ValueError):
+    """The input is missing, not a video, or unreadable; the message is one line."""
+
+
+@dataclass(frozen=True)
+class VideoInfo:
+    path: Path
+    width: int  # as displayed, after the container's rotation
+    height: int
+    fps: float
+    duration: float | None
+    rotation: int  # display rotation in degrees, counter-clockwise
+    has_audio: bool
+    codec: str
+    pix_fmt: str
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return (self.height, self.width)
+
+
+_VIDEO = re.compile(r"Stream #\S+.*?: Video: (\w+).*?, (\w+)(?:\([^)]*\))?, .*?(\d{2,5})x(\d{2,5})")
+_FPS = re.compile(r"(\d+(?:\.\d+)?) (?:fps|tbr)")
+_DURATION = re.compile(r"Duration: (\d+):(\d+):(\d+(?:\.\d+)?)")
+_ROTATION = re.compile(r"rotation of (-?\d+(?:\.\d+)?) degrees|rotate\s*:\s*(-?\d+)")
+
+
+def probe(path: str | Path) -> VideoInfo:
+    """What FFmpeg reports of the first video stream, or :class:`VideoError`."""
+    path = Path(path)
+    if not path.exists():
+        raise VideoError(f"{path}: no such file")
+    if path.is_dir():
+        raise VideoError(f"{path}: is a folder, not a video")
+    result = subprocess.run(
+        [ffmpeg_exe(), "-hide_banner", "-nostdin", "-i", str(path)],
+        capture_output=True,
+        text=True,
+        errors="replace",
+    )
+    text = result.stderr
+    video = _VIDEO.search(text)
+    if video is None:
+        raise VideoError(f"{path}: not a video FFmpeg can read")
+    codec, pix_fmt, w, h = video.group(1), video.group(2), int(video.group(3)), int(video.group(4))
+    stream_line = text[video.start() : text.find("\n", video.start())]
+    fps_match = _FPS.search(stream_line)
+    fps = float(fps_match.group(1)) if fps_match else 0.0
+    dur = _DURATION.search(text)
+    duration = (
+        int(dur.group(1)) * 3600 + int(dur.group(2)) * 60 + float(dur.group(3)) if dur else None
+    )
+    rot = _ROTATION.search(text)
+    rotation = int(round(float(rot.group(1) or rot.group(2)))) % 360 if rot else 0
+    if rotation in (90, 270):
+        w, h = h, w
+    has_audio = re.search(r"Stream #\S+.*?: Audio:", text) is not None
+    return VideoInfo(path, w, h, fps, duration, rotation, has_audio, codec, pix_fmt)
+
+
+def read_frames(
+    path: str | Path, size: tuple[int, int] | None = None, info: VideoInfo | None = None
+) -> Iterator[NDArray[np.uint8]]:
+    """RGB uint8 frames (H, W, 3), streamed; resized to ``size`` (H, W) if given.
+
+    FFmpeg applies the display rotation, so frames come upright. A stream that ends
+    early or breaks raises :class:`VideoError` after the frames that did decode.
+    """
+    info = info or probe(path)
+    h, w = size or info.size
+    stream = ffmpeg.input(str(path))
+    if size is not None and size != info.size:
+        stream = stream.filter("scale", w, h, flags="area")
+    process = (
+        stream.output("pipe:", format="rawvideo", pix_fmt="rgb24", fps_mode="passthrough")
+        .global_args("-hide_banner", "-loglevel", "error", "-nostdin")
+        .run_async(cmd=ffmpeg_exe(), pipe_stdout=True, pipe_stderr=True)
+    )
+    frame_bytes = h * w * 3
+    try:
+        while True:
+            buf = process.stdout.read(frame_bytes)
+            if len(buf) < frame_bytes:
+                break
+            yield np.frombuffer(buf, np.uint8).reshape(h, w, 3)
+    finally:
+        process.stdout.close()
+        err = process.stderr.read().decode(errors="replace").strip()
+        code = process.wait()
+    if code != 0:
+        last = err.splitlines()[-1] if err else f"exit status {code}"
+        raise VideoError(f"{path}: decoding failed: {last}")

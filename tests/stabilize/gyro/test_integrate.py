@@ -1,0 +1,56 @@
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rotation import so3
+from stabilize.gyro import GyroError, GyroLog, integrate_rotations, read_opencamera
+from stabilize.rotation_files import read_rotations
+
+SAMPLE = Path(__file__).resolve().parents[3] / "samples" / "street"
+
+
+def test_gyro_log_integrated_with_the_truth_offset_and_axes_reproduces_truth():
+    meta = json.loads((SAMPLE / "truth.json").read_text())
+    log = read_opencamera(SAMPLE / "gyro.csv")
+    assert log.rate_hz == pytest.approx(meta["gyro_rate"], rel=1e-6)
+    unbiased = GyroLog(log.times, log.rates - np.array(meta["gyro_bias"]), log.source)
+    truth = read_rotations(SAMPLE / "truth.csv")
+    times = np.arange(meta["n_frames"]) / meta["fps"]
+    R = integrate_rotations(unbiased, times, meta["offset_s"], np.array(meta["R_cam_imu"]))
+    R_true = so3.exp_so3(np.array([truth[k] for k in range(len(R))]))
+    assert so3.angular_error_deg(R, R_true).mean() < 0.01
+    # The wrong axes or offset are far off: the test can fail.
+    wrong = integrate_rotations(unbiased, times, meta["offset_s"], np.eye(3))
+    assert so3.angular_error_deg(wrong, R_true).mean() > 0.1
+
+
+def test_constant_rate_integrates_to_the_exponential():
+    t = np.linspace(0, 1, 401)
+    w = np.array([0.3, -0.2, 0.5])
+    log = GyroLog(t, np.tile(w, (len(t), 1)), "const")
+    R = integrate_rotations(log, np.array([0.1, 0.35, 0.6]))
+    np.testing.assert_allclose(R[0], so3.exp_so3(-w * 0.25), atol=1e-12)
+
+
+def test_a_log_shorter_than_the_video_is_refused():
+    log = GyroLog(np.linspace(0, 1, 100), np.zeros((100, 3)), "short")
+    with pytest.raises(GyroError, match="covers"):
+        integrate_rotations(log, np.array([0.5, 1.5]))
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("", "no gyro samples"),
+        ("0.1,0.2,0.3,100\n0.1,0.2,0.3,50\n", "does not increase"),
+        ("0.1,0.2,100\n", "expected 4"),
+        ("0.1,0.2,x,100\n", "not a number"),
+    ],
+)
+def test_bad_opencamera_logs(tmp_path, text, message):
+    path = tmp_path / "gyro.csv"
+    path.write_text(text)
+    with pytest.raises(GyroError, match=message):
+        read_opencamera(path)
