@@ -7,7 +7,9 @@ that implements it. This module is only the shell: version, help and dispatch.
 
 from __future__ import annotations
 
+import contextlib
 import json
+import sys
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import NoReturn
@@ -201,9 +203,186 @@ def evaluate(
         )
 
 
+def _settings(
+    flow_name,
+    raft_weights,
+    device,
+    fov,
+    focal,
+    smooth,
+    method,
+    lock,
+    max_zoom,
+    crop,
+    codec,
+    crf,
+    preset,
+):
+    from stabilize.pipeline import Settings
+    from stabilize.video_writer import Encoding
+
+    flow_options = {}
+    if flow_name.startswith("raft"):
+        flow_options = {"weights": raft_weights, "device": device}
+    elif device == "cuda":
+        _fail("--device cuda needs a RAFT flow backend (--flow raft)")
+    return Settings(
+        flow=flow_name,
+        flow_options=flow_options,
+        fov=fov,
+        focal=focal,
+        smooth=smooth,
+        method="lock" if lock else method,
+        max_zoom=max_zoom,
+        crop=crop,
+        encoding=Encoding(codec=codec, crf=crf, preset=preset),
+    )
+
+
+FLOW_HELP = "Optical flow: dis (fast, CPU), raft or raft-large (needs weights)."
+
+
+@app.command(
+    "run",
+    epilog=(
+        "The main job; `stabilize IN OUT` is short for `stabilize run IN OUT`.\n\n"
+        "Examples:\n\n"
+        "  stabilize shaky.mp4 steady.mp4\n\n"
+        "  stabilize shaky.mp4 steady.mp4 --smooth 1.0 --max-zoom 1.3 --report report/\n\n"
+        "  stabilize drone.mp4 locked.mp4 --lock --crop dynamic\n\n"
+        "  stabilize in.mp4 out.mp4 --flow raft --raft-weights raft-small.pth --device cuda"
+    ),
+)
+def run(
+    input_path: Path = typer.Argument(..., metavar="IN", help="The shaky video."),
+    output_path: Path = typer.Argument(..., metavar="OUT", help="Where to write the result."),
+    flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
+    raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
+    device: str = typer.Option("cpu", help="cpu or cuda (for RAFT)."),
+    fov: float | None = typer.Option(
+        None, help="Horizontal field of view, deg (default 69: a phone's main camera)."
+    ),
+    focal: float | None = typer.Option(None, help="Focal length in pixels (overrides --fov)."),
+    smooth: float = typer.Option(0.5, min=0.01, help="Smoothing time constant, s."),
+    method: str = typer.Option("adaptive", help="adaptive (follows pans) or gaussian."),
+    lock: bool = typer.Option(False, help="Hold one orientation, like a tripod."),
+    max_zoom: float = typer.Option(1.5, min=1.0, help="Never zoom in more than this."),
+    crop: str = typer.Option("auto", help="auto (one zoom), dynamic (smoothly varying), none."),
+    codec: str = typer.Option("libx264", help="libx264 or libx265."),
+    crf: int = typer.Option(18, min=0, max=51, help="Encoder quality (lower is better)."),
+    preset: str = typer.Option("medium", help="Encoder speed preset."),
+    report: Path | None = typer.Option(
+        None, help="Write rotations.csv, path.csv, trajectory.png and summary.json here."
+    ),
+    overwrite: bool = typer.Option(False, help="Replace OUT if it exists."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar."),
+    as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON on stdout."),
+) -> None:
+    """Stabilise a video: estimate each frame's rotation, smooth the path, warp, encode."""
+    from stabilize.pipeline import stabilize_video
+    from stabilize.progress import progress_bar
+    from stabilize.video_reader import VideoError
+
+    settings = _settings(
+        flow_name,
+        raft_weights,
+        device,
+        fov,
+        focal,
+        smooth,
+        method,
+        lock,
+        max_zoom,
+        crop,
+        codec,
+        crf,
+        preset,
+    )
+    with contextlib.ExitStack() as stack:
+
+        def bar(label: str, total: int | None):
+            return stack.enter_context(progress_bar(label, total, quiet=quiet))
+
+        try:
+            summary, planned = stabilize_video(
+                input_path, output_path, settings, overwrite=overwrite, progress=bar
+            )
+        except (VideoError, ValueError, FileExistsError, FileNotFoundError, RuntimeError) as err:
+            _fail(str(err))
+    if report is not None:
+        from stabilize.report import write_report
+
+        write_report(report, planned, summary)
+    if as_json:
+        typer.echo(json.dumps(summary, indent=2))
+    elif not quiet:
+        typer.echo(
+            f"{output_path}: {summary['frames']} frames, zoom {summary['zoom']:.3f}, "
+            f"{summary['fps']:.1f} fps",
+            err=True,
+        )
+
+
+@app.command(
+    epilog=(
+        "Examples:\n\n"
+        "  stabilize rotations clip.mp4 -o rotations.csv\n\n"
+        "  stabilize rotations clip.mp4 -o rot.csv --flow raft --raft-weights raft-small.pth"
+    )
+)
+def rotations(
+    input_path: Path = typer.Argument(..., metavar="IN", help="A video."),
+    output: Path = typer.Option(..., "-o", "--output", help="CSV: frame,t,rx,ry,rz,support."),
+    flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
+    raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
+    device: str = typer.Option("cpu", help="cpu or cuda (for RAFT)."),
+    fov: float | None = typer.Option(None, help="Horizontal field of view, deg (default 69)."),
+    focal: float | None = typer.Option(None, help="Focal length in pixels (overrides --fov)."),
+    overwrite: bool = typer.Option(False, help="Replace the output if it exists."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar."),
+) -> None:
+    """Estimate only: the camera rotation R_t of every frame pair (radians)."""
+    from rotation import so3
+    from stabilize.ffmpeg_tools import atomic_output
+    from stabilize.pipeline import estimate_rotations
+    from stabilize.progress import progress_bar
+    from stabilize.rotation_files import write_rotations
+    from stabilize.video_reader import VideoError, probe
+
+    settings = _settings(
+        flow_name,
+        raft_weights,
+        device,
+        fov,
+        focal,
+        0.5,
+        "gaussian",
+        False,
+        1.5,
+        "auto",
+        "libx264",
+        18,
+        "medium",
+    )
+    try:
+        info = probe(input_path)
+        with progress_bar("estimating", None, quiet=quiet) as advance:
+            times, R, support = estimate_rotations(input_path, info, settings, advance)
+        with atomic_output(output, overwrite=overwrite) as tmp:
+            write_rotations(tmp, times[:-1], so3.log_so3(R), support)
+    except (VideoError, ValueError, FileExistsError, RuntimeError) as err:
+        _fail(str(err))
+
+
+COMMANDS = ("run", "rotations", "synth", "evaluate", "compare", "batch")
+
+
 def main() -> None:
-    """Console-script entry point."""
-    app()
+    """Console-script entry point: a first argument that is no command runs the main job."""
+    args = sys.argv[1:]
+    if args and not args[0].startswith("-") and args[0] not in COMMANDS:
+        args = ["run", *args]
+    app(args=args, prog_name="stabilize")
 
 
 if __name__ == "__main__":

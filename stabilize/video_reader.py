@@ -111,3 +111,46 @@ def read_frames(
     if code != 0:
         last = err.splitlines()[-1] if err else f"exit status {code}"
         raise VideoError(f"{path}: decoding failed: {last}")
+    if "partial file" in err:
+        raise VideoError(f"{path}: truncated: the file ends before its last frame")
+
+
+def frame_times(path: str | Path) -> np.ndarray:
+    """Presentation times (s) of every video frame, from the first, in display order.
+
+    Read from the container's packets (no decoding), so variable frame rate is exact.
+    """
+    result = subprocess.run(
+        [
+            ffmpeg_exe(),
+            "-hide_banner",
+            "-nostdin",
+            "-i",
+            str(path),
+            "-map",
+            "0:v:0",
+            "-c",
+            "copy",
+            "-f",
+            "framecrc",
+            "-",
+        ],
+        capture_output=True,
+        text=True,
+        errors="replace",
+    )
+    tb = re.search(r"#tb 0: (\d+)/(\d+)", result.stdout)
+    if "partial file" in result.stderr:
+        raise VideoError(f"{path}: truncated: the file ends before its last frame")
+    if result.returncode != 0 or tb is None:
+        raise VideoError(f"{path}: cannot read frame timestamps")
+    scale = int(tb.group(1)) / int(tb.group(2))
+    pts = []
+    for line in result.stdout.splitlines():
+        if line.startswith("0,"):
+            fields = [f.strip() for f in line.split(",")]
+            pts.append(int(fields[2]))
+    if not pts:
+        raise VideoError(f"{path}: no video frames")
+    times = np.sort(np.array(pts, dtype=np.float64)) * scale
+    return times - times[0]

@@ -23,8 +23,9 @@ class Encoding:
 class FrameWriter:
     """Streams RGB uint8 frames into an encoder process.
 
-    Constant frame rate ``fps``; an optional extra input (e.g. an audio source given
-    as ffmpeg-python stream) is muxed in and cut to the video's length.
+    Constant frame rate ``fps``. An optional audio stream (ffmpeg-python) is muxed in:
+    copied untouched (``copy_audio``, for a source file's audio) or encoded to AAC and
+    cut to the video's length (for a generated tone).
     """
 
     def __init__(
@@ -32,9 +33,12 @@ class FrameWriter:
         path: str | Path,
         size: tuple[int, int],
         fps: float,
-        encoding: Encoding = Encoding(),
+        encoding: Encoding | None = None,
         audio=None,
+        *,
+        copy_audio: bool = False,
     ) -> None:
+        encoding = encoding or Encoding()
         h, w = size
         self.size = size
         video = ffmpeg.input(
@@ -49,7 +53,9 @@ class FrameWriter:
             "format": "mp4",
             "movflags": "+faststart",
         }
-        if audio is not None:
+        if audio is not None and copy_audio:
+            options.update(acodec="copy")
+        elif audio is not None:
             options.update(acodec="aac", shortest=None)
         self._process = (
             ffmpeg.output(*streams, str(path), **options)

@@ -1,0 +1,228 @@
+"""The stabiliser: two streaming passes over the video, memory independent of its length.
+
+1. Decode at the flow's working size (~480 px), compute optical flow between
+   consecutive frames, and estimate each pair's rotation R_t (:mod:`rotation`).
+2. Chain the rotations into orientations O_t, smooth them on SO(3), fit the zoom
+   budget, and choose the zoom (:mod:`stabilize.smoothing`, :mod:`stabilize.warping`).
+3. Decode at full resolution, warp each frame by K' C_t K⁻¹, and encode, copying the
+   audio untouched.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import ffmpeg
+import numpy as np
+from numpy.typing import NDArray
+
+import flow
+from rotation import HoughEstimator, so3
+from rotation.camera import focal_from_fov, intrinsics
+from stabilize.ffmpeg_tools import atomic_output
+from stabilize.smoothing import (
+    orientations_from_rotations,
+    respect_zoom_budget,
+    smooth_orientations,
+)
+from stabilize.video_reader import VideoError, VideoInfo, frame_times, probe, read_frames
+from stabilize.video_writer import Encoding, FrameWriter
+from stabilize.warping import homography, required_zoom, warp_frame
+
+# A phone's main camera is about 26 mm full-frame equivalent: 69° across the long side.
+DEFAULT_HFOV = 69.0
+CROP_MODES = ("auto", "dynamic", "none")
+ESTIMATE_CHUNK = 32  # flow fields held at once in pass 1
+
+
+@dataclass(frozen=True)
+class Settings:
+    flow: str = "dis"
+    flow_options: dict = field(default_factory=dict)
+    fov: float | None = None
+    focal: float | None = None
+    smooth: float = 0.5
+    method: str = "adaptive"
+    max_zoom: float = 1.5
+    crop: str = "auto"
+    max_deg: float = 15.0
+    encoding: Encoding = field(default_factory=Encoding)
+
+    def focal_px(self, width: int) -> float:
+        if self.focal is not None:
+            return float(self.focal)
+        return focal_from_fov(self.fov or DEFAULT_HFOV, width)
+
+
+@dataclass
+class CameraPath:
+    """The estimated and the planned camera path of a clip."""
+
+    times: NDArray  # (N,) s
+    rotations: NDArray  # (N-1, 3, 3) R_t
+    support: NDArray  # (N-1,)
+    raw: NDArray  # (N, 3, 3) O_t
+    smooth: NDArray  # (N, 3, 3) S_t
+    zoom: NDArray  # (N,) applied zoom
+    homographies: NDArray  # (N, 3, 3) input → output pixels
+    K: NDArray
+
+
+Progress = Callable[[int], None]
+
+
+def _no_progress(_: int = 1) -> None:
+    return None
+
+
+def estimate_rotations(
+    path: Path, info: VideoInfo, settings: Settings, progress: Progress = _no_progress
+) -> tuple[NDArray, NDArray, NDArray]:
+    """Pass 1: (times, R_t, support) for the clip; frames streamed at the working size."""
+    times = frame_times(path)
+    if len(times) < 2:
+        raise VideoError(f"{path}: has {len(times)} frame(s); nothing to stabilise")
+    ws = flow.working_size(info.size)
+    focal = settings.focal_px(info.width) * ws.scale[0]
+    estimator = HoughEstimator(ws.size, focal, max_deg=settings.max_deg)
+    backend = flow.get(settings.flow, **settings.flow_options)
+    rotations, support, chunk = [], [], []
+
+    def flush() -> None:
+        for est in estimator.estimate_many(np.stack(chunk)):
+            rotations.append(est.matrix)
+            support.append(est.support)
+        progress(len(chunk))
+        chunk.clear()
+
+    for f in backend.many(read_frames(path, ws.size, info)):
+        chunk.append(f)
+        if len(chunk) == ESTIMATE_CHUNK:
+            flush()
+    if chunk:
+        flush()
+    n = len(rotations) + 1
+    if n < 2:
+        raise VideoError(f"{path}: fewer than two frames decoded; nothing to stabilise")
+    if n < len(times) - 1:
+        raise VideoError(
+            f"{path}: truncated or damaged: the container lists {len(times)} frames, "
+            f"only {n} decode"
+        )
+    if len(times) != n:  # a frame's worth of slack for containers that list one extra
+        times = times[:n] if len(times) > n else np.arange(n) / max(info.fps, 1.0)
+    return times, np.array(rotations), np.array(support)
+
+
+def plan(
+    times: NDArray,
+    rotations: NDArray,
+    support: NDArray,
+    K: NDArray,
+    size: tuple[int, int],
+    settings: Settings,
+) -> CameraPath:
+    """Smooth the path, keep it within the zoom budget, and choose each frame's zoom."""
+    if settings.crop not in CROP_MODES:
+        raise ValueError(f"crop must be one of {CROP_MODES}, got {settings.crop!r}")
+    O = orientations_from_rotations(rotations)
+    S = smooth_orientations(O, times, settings.smooth, settings.method)
+
+    def zoom_of(path: NDArray) -> NDArray:
+        C = path @ np.swapaxes(O, -1, -2)
+        return np.array([required_zoom(K, c, size, settings.max_zoom * 1.001) for c in C])
+
+    if settings.crop == "none":
+        need = np.ones(len(O))
+    else:
+        S, need = respect_zoom_budget(O, S, times, zoom_of, settings.max_zoom, settings.smooth)
+    zoom = choose_zoom(need, times, settings)
+    C = S @ np.swapaxes(O, -1, -2)
+    H = np.array([homography(K, c, z) for c, z in zip(C, zoom, strict=True)])
+    return CameraPath(times, rotations, support, O, S, zoom, H, K)
+
+
+def choose_zoom(need: NDArray, times: NDArray, settings: Settings) -> NDArray:
+    """auto: one zoom for the clip; dynamic: a smooth per-frame zoom ≥ need; none: 1."""
+    need = np.minimum(need, settings.max_zoom)
+    if settings.crop == "none":
+        return np.ones_like(need)
+    if settings.crop == "auto":
+        return np.full_like(need, need.max())
+    # The upper envelope of a Gaussian bump 1 + (need_j - 1) g(t - t_j) around every
+    # frame: never below any frame's need, and it eases in and out of each one.
+    sigma = max(settings.smooth, 0.1)
+    bumps = np.exp(-0.5 * ((times[:, None] - times[None, :]) / sigma) ** 2)
+    return np.max(1.0 + (need[None, :] - 1.0) * bumps, axis=1)
+
+
+def render(
+    path: Path,
+    out: Path,
+    info: VideoInfo,
+    planned: CameraPath,
+    settings: Settings,
+    progress: Progress = _no_progress,
+) -> int:
+    """Pass 2: decode, warp, encode with the audio copied; returns frames written."""
+    audio = ffmpeg.input(str(path)).audio if info.has_audio else None
+    written = 0
+    fps = info.fps or 30.0
+    with FrameWriter(out, info.size, fps, settings.encoding, audio, copy_audio=True) as writer:
+        for frame, H in zip(read_frames(path, info=info), planned.homographies, strict=False):
+            writer.write(warp_frame(frame, H))
+            written += 1
+            progress(1)
+    return written
+
+
+def stabilize_video(
+    input_path: str | os.PathLike,
+    output_path: str | os.PathLike,
+    settings: Settings | None = None,
+    *,
+    overwrite: bool = False,
+    progress: Callable[[str, int | None], Progress] | None = None,
+) -> tuple[dict, CameraPath]:
+    """Stabilise a clip into ``output_path`` (atomically); returns (summary, path)."""
+    settings = settings or Settings()
+    src, dst = Path(input_path), Path(output_path)
+    same = src.resolve() == dst.resolve() or (dst.exists() and os.path.samefile(src, dst))
+    if same:
+        raise ValueError(f"the output {dst} is the input; choose another name")
+    if dst.exists() and not overwrite:
+        raise FileExistsError(f"{dst} exists (use --overwrite to replace it)")
+    info = probe(src)
+    start = time.perf_counter()
+    bar = progress or (lambda label, total: _no_progress)
+    times, R, support = estimate_rotations(src, info, settings, bar("estimating", None))
+    t_estimate = time.perf_counter() - start
+    K = intrinsics(settings.focal_px(info.width), info.size)
+    planned = plan(times, R, support, K, info.size, settings)
+    t_plan = time.perf_counter() - start - t_estimate
+    with atomic_output(dst, overwrite=overwrite) as tmp:
+        frames = render(src, tmp, info, planned, settings, bar("stabilising", len(times)))
+    total = time.perf_counter() - start
+    summary = {
+        "input": str(src),
+        "output": str(dst),
+        "frames": frames,
+        "size": [info.width, info.height],
+        "focal_px": float(K[0, 0]),
+        "zoom": float(planned.zoom.max()),
+        "mean_support": float(np.mean(support)),
+        "mean_rotation_deg": float(np.degrees(so3.angle(R)).mean()),
+        "seconds": {
+            "estimate": t_estimate,
+            "plan": t_plan,
+            "render": total - t_estimate - t_plan,
+            "total": total,
+        },
+        "fps": frames / total,
+        "settings": {k: v for k, v in asdict(settings).items() if k != "encoding"},
+    }
+    return summary, planned

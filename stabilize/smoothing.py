@@ -1,0 +1,114 @@
+"""Smoothing the camera's orientation path on SO(3) (never on Euler angles).
+
+Orientations O_t (world → camera) are averaged in the tangent space of each frame:
+
+    S_t = exp( Σ_j w_tj log(O_j O_tᵀ) ) O_t,     Σ_j w_tj = 1,
+
+one Gauss-Newton step of the weighted Karcher mean, which is exact enough at the small
+angles a hand covers within a smoothing window. The weights are a Gaussian in time
+(zero phase: no lag), with σ = ``smooth`` seconds.
+
+``adaptive`` narrows the window where the camera turns fast, so intentional pans are
+followed closely while shake is still removed (the idea of Gyroflow's default). ``lock``
+holds one orientation, as on a tripod.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rotation import so3
+
+METHODS = ("adaptive", "gaussian", "lock")
+ADAPTIVE_REF_DEG_S = 30.0  # angular speed at which the window halves
+
+
+def _gaussian_mean(O: NDArray, times: NDArray, sigma: NDArray) -> NDArray:
+    n = len(O)
+    out = np.empty_like(O)
+    for t in range(n):
+        s = max(float(sigma[t]), 1e-6)
+        lo = np.searchsorted(times, times[t] - 3 * s)
+        hi = np.searchsorted(times, times[t] + 3 * s, side="right")
+        w = np.exp(-0.5 * ((times[lo:hi] - times[t]) / s) ** 2)
+        w /= w.sum()
+        tangent = so3.log_so3(O[lo:hi] @ O[t].T)
+        out[t] = so3.exp_so3(w @ tangent) @ O[t]
+    return out
+
+
+def angular_speed(O: NDArray, times: NDArray) -> NDArray:
+    """|ω| per frame in rad/s, from consecutive orientations (last repeated)."""
+    if len(O) < 2:
+        return np.zeros(len(O))
+    R = O[1:] @ np.swapaxes(O[:-1], -1, -2)
+    speed = so3.angle(R) / np.maximum(np.diff(times), 1e-6)
+    return np.append(speed, speed[-1])
+
+
+def smooth_orientations(
+    O: NDArray, times: NDArray, smooth: float = 0.5, method: str = "adaptive"
+) -> NDArray[np.float64]:
+    """The smoothed path S_t for orientations O_t (N, 3, 3) at ``times`` (s)."""
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    O = np.asarray(O, dtype=np.float64)
+    times = np.asarray(times, dtype=np.float64)
+    if method == "lock":
+        # Hold the mean orientation: it needs less zoom than holding the first one.
+        mean = so3.exp_so3(so3.log_so3(O @ O[0].T).mean(axis=0)) @ O[0]
+        return np.broadcast_to(mean, O.shape).copy()
+    if len(O) < 2:
+        return O.copy()
+    sigma = np.full(len(O), float(smooth))
+    if method == "adaptive":
+        # The slow component of the motion decides how wide the window may be.
+        slow = _gaussian_mean(O, times, sigma)
+        speed = np.degrees(angular_speed(slow, times))
+        sigma = smooth / (1.0 + speed / ADAPTIVE_REF_DEG_S)
+        sigma = np.convolve(np.pad(sigma, 2, mode="edge"), np.ones(5) / 5, mode="valid")
+    return _gaussian_mean(O, times, sigma)
+
+
+def orientations_from_rotations(R: NDArray) -> NDArray[np.float64]:
+    """O_0 = I and O_{t+1} = R_t O_t, for frame-to-frame rotations R_t (N-1, 3, 3)."""
+    O = np.empty((len(R) + 1, 3, 3))
+    O[0] = np.eye(3)
+    for k, r in enumerate(R):
+        O[k + 1] = r @ O[k]
+    return O
+
+
+def blend(S: NDArray, O: NDArray, amount: NDArray) -> NDArray[np.float64]:
+    """Per frame, move S_t the fraction ``amount`` of the way to O_t (geodesically)."""
+    step = so3.log_so3(O @ np.swapaxes(S, -1, -2)) * np.asarray(amount)[:, None]
+    return so3.exp_so3(step) @ S
+
+
+def respect_zoom_budget(
+    O: NDArray, S: NDArray, times: NDArray, zoom_of, max_zoom: float, smooth: float
+) -> tuple[NDArray, NDArray]:
+    """Bend the smooth path towards the raw one where it would need more than max_zoom.
+
+    ``zoom_of(S)`` gives the zoom each frame needs. The pull is itself smoothed in time,
+    so the path stays smooth; it grows until no frame needs more than ``max_zoom`` (the
+    raw path needs none, so this ends). Returns (S, per-frame zoom).
+    """
+    amount = np.zeros(len(O))
+    zoom = zoom_of(S)
+    sigma = max(smooth, 1e-3) / 2
+    for _ in range(40):
+        over = zoom > max_zoom
+        if not over.any():
+            break
+        amount = np.clip(amount + 0.25 * over, 0.0, 1.0)
+        # Spread the pull over neighbouring frames (a Gaussian in time, peak kept).
+        spread = np.array(
+            [np.max(amount * np.exp(-0.5 * ((times - t) / sigma) ** 2)) for t in times]
+        )
+        S_new = blend(S, O, spread)
+        zoom = zoom_of(S_new)
+    else:
+        S_new, zoom = O.copy(), zoom_of(O)
+    return (S_new if amount.any() else S), zoom
