@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import csv
 import json
+import multiprocessing as mp
+import os
 from collections.abc import Callable, Iterator
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -100,40 +102,69 @@ def build_scene(opts: SynthOptions) -> Scene:
     return Scene.build(rng, street, crowd, bg)
 
 
-def render_frames(
-    opts: SynthOptions, scene: Scene | None = None, *, with_flow: bool = False
-) -> Iterator[tuple[NDArray[np.uint8], NDArray[np.float32] | None]]:
-    """Frames in order, each with the exact flow to the next frame if asked.
+def render_frame(
+    opts: SynthOptions, scene: Scene, k: int, *, with_flow: bool = False
+) -> tuple[NDArray[np.uint8], NDArray[np.float32] | None]:
+    """Frame k, with the exact flow to frame k+1 if asked (None for the last frame).
 
     Under a rolling shutter row r is exposed at t + r / H · readout; ground-truth flow
     is only defined for a global shutter.
     """
+    h, w = opts.size
+    K = opts.K()
+    yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+    rays = np.stack([(xx - K[0, 2]) / K[0, 0], (yy - K[1, 2]) / K[1, 1], np.ones_like(xx)], -1)
+    readout = opts.rolling_shutter_ms / 1000.0
+    t = k / opts.fps
+    t_rows = t + readout * np.arange(h) / h if readout else np.full(h, t)
+    if readout:
+        C = trajectory.camera_to_world(opts.motion, t_rows)
+        c = trajectory.position(opts.motion, t_rows)
+    else:
+        C = np.broadcast_to(trajectory.camera_to_world(opts.motion, t), (h, 3, 3))
+        c = np.broadcast_to(trajectory.position(opts.motion, t), (h, 3))
+    hits = cast(scene, rays, C, c, t_rows, opts.focal)
+    flow = None
+    if with_flow and k + 1 < opts.n_frames:
+        t1 = t + 1.0 / opts.fps
+        O1 = trajectory.orientation(opts.motion, t1)
+        flow = ground_truth_flow(hits, K, O1, trajectory.position(opts.motion, t1), 1 / opts.fps)
+    return hits.colour, flow
+
+
+_WORKER: tuple = ()  # (opts, scene, with_flow) inherited by forked render workers
+
+
+def _render_in_worker(k: int):
+    opts, scene, with_flow = _WORKER
+    return render_frame(opts, scene, k, with_flow=with_flow)
+
+
+def render_frames(
+    opts: SynthOptions,
+    scene: Scene | None = None,
+    *,
+    with_flow: bool = False,
+    workers: int | None = None,
+) -> Iterator[tuple[NDArray[np.uint8], NDArray[np.float32] | None]]:
+    """All frames in order (see :func:`render_frame`), rendered by ``workers`` processes.
+
+    Frames are independent, so they render in parallel (default: one process per core,
+    forked, so the scene is shared rather than copied); they still arrive in order.
+    """
+    global _WORKER
     if with_flow and opts.rolling_shutter_ms:
         raise ValueError("ground-truth flow needs a global shutter (rolling_shutter_ms=0)")
     scene = scene or build_scene(opts)
-    h, w = opts.size
-    K = opts.K()
-    yy, xx = np.mgrid[0:h, 0:w].astype(np.float64)
-    rays = np.stack([(xx - K[0, 2]) / K[0, 0], (yy - K[1, 2]) / K[1, 1], np.ones_like(xx)], -1)
-    rays = rays.astype(np.float32)
-    readout = opts.rolling_shutter_ms / 1000.0
-    for k, t in enumerate(frame_times(opts)):
-        t_rows = t + readout * np.arange(h) / h if readout else np.full(h, t)
-        if readout:
-            C = trajectory.camera_to_world(opts.motion, t_rows)
-            c = trajectory.position(opts.motion, t_rows)
-        else:
-            C = np.broadcast_to(trajectory.camera_to_world(opts.motion, t), (h, 3, 3))
-            c = np.broadcast_to(trajectory.position(opts.motion, t), (h, 3))
-        hits = cast(scene, rays, C, c, t_rows, opts.focal)
-        flow = None
-        if with_flow and k + 1 < opts.n_frames:
-            t1 = t + 1.0 / opts.fps
-            O1 = trajectory.orientation(opts.motion, t1)
-            flow = ground_truth_flow(
-                hits, K, O1, trajectory.position(opts.motion, t1), 1.0 / opts.fps
-            )
-        yield hits.colour, flow
+    workers = workers or min(os.cpu_count() or 1, 4)
+    frames = range(opts.n_frames)
+    if workers < 2 or opts.n_frames < 8 or "fork" not in mp.get_all_start_methods():
+        for k in frames:
+            yield render_frame(opts, scene, k, with_flow=with_flow)
+        return
+    _WORKER = (opts, scene, with_flow)
+    with mp.get_context("fork").Pool(workers) as pool:
+        yield from pool.imap(_render_in_worker, frames)
 
 
 def gyro_samples(opts: SynthOptions) -> tuple[NDArray, NDArray]:
@@ -192,7 +223,9 @@ def render_clip(
     write_truth(out, opts)
     with atomic_output(out / "clip.mp4", overwrite=True) as tmp:
         audio = sine_audio(opts.n_frames / opts.fps)
-        with FrameWriter(tmp, opts.size, opts.fps, Encoding(crf=opts.crf), audio) as writer:
+        with FrameWriter(
+            tmp, opts.size, opts.fps, Encoding(crf=opts.crf, preset="veryfast"), audio
+        ) as writer:
             for frame, _ in render_frames(opts):
                 writer.write(frame)
                 if progress:
