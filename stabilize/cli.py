@@ -203,40 +203,16 @@ def evaluate(
         )
 
 
-def _settings(
-    flow_name,
-    raft_weights,
-    device,
-    fov,
-    focal,
-    smooth,
-    method,
-    lock,
-    max_zoom,
-    crop,
-    codec,
-    crf,
-    preset,
-):
+def _settings(flow_name: str, raft_weights: Path | None, device: str, **options):
+    """Settings for the pipeline; options are Settings fields (fov, smooth, crop, ...)."""
     from stabilize.pipeline import Settings
-    from stabilize.video_writer import Encoding
 
     flow_options = {}
     if flow_name.startswith("raft"):
         flow_options = {"weights": raft_weights, "device": device}
     elif device == "cuda":
         _fail("--device cuda needs a RAFT flow backend (--flow raft)")
-    return Settings(
-        flow=flow_name,
-        flow_options=flow_options,
-        fov=fov,
-        focal=focal,
-        smooth=smooth,
-        method="lock" if lock else method,
-        max_zoom=max_zoom,
-        crop=crop,
-        encoding=Encoding(codec=codec, crf=crf, preset=preset),
-    )
+    return Settings(flow=flow_name, flow_options=flow_options, **options)
 
 
 FLOW_HELP = "Optical flow: dis (fast, CPU), raft or raft-large (needs weights)."
@@ -274,6 +250,9 @@ def run(
     report: Path | None = typer.Option(
         None, help="Write rotations.csv, path.csv, trajectory.png and summary.json here."
     ),
+    preview: str = typer.Option(
+        "none", help="side-by-side: the original and the stabilised clip next to each other."
+    ),
     overwrite: bool = typer.Option(False, help="Replace OUT if it exists."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar."),
     as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON on stdout."),
@@ -282,21 +261,22 @@ def run(
     from stabilize.pipeline import stabilize_video
     from stabilize.progress import progress_bar
     from stabilize.video_reader import VideoError
+    from stabilize.video_writer import Encoding
 
+    if preview not in ("none", "side-by-side"):
+        _fail(f"--preview must be none or side-by-side, got {preview!r}")
     settings = _settings(
         flow_name,
         raft_weights,
         device,
-        fov,
-        focal,
-        smooth,
-        method,
-        lock,
-        max_zoom,
-        crop,
-        codec,
-        crf,
-        preset,
+        fov=fov,
+        focal=focal,
+        smooth=smooth,
+        method="lock" if lock else method,
+        max_zoom=max_zoom,
+        crop=crop,
+        preview=preview == "side-by-side",
+        encoding=Encoding(codec=codec, crf=crf, preset=preset),
     )
     with contextlib.ExitStack() as stack:
 
@@ -349,21 +329,7 @@ def rotations(
     from stabilize.rotation_files import write_rotations
     from stabilize.video_reader import VideoError, probe
 
-    settings = _settings(
-        flow_name,
-        raft_weights,
-        device,
-        fov,
-        focal,
-        0.5,
-        "gaussian",
-        False,
-        1.5,
-        "auto",
-        "libx264",
-        18,
-        "medium",
-    )
+    settings = _settings(flow_name, raft_weights, device, fov=fov, focal=focal)
     try:
         info = probe(input_path)
         with progress_bar("estimating", None, quiet=quiet) as advance:

@@ -50,6 +50,7 @@ class Settings:
     max_zoom: float = 1.5
     crop: str = "auto"
     max_deg: float = 15.0
+    preview: bool = False  # write original | stabilised side by side
     encoding: Encoding = field(default_factory=Encoding)
 
     def focal_px(self, width: int) -> float:
@@ -172,9 +173,12 @@ def render(
     audio = ffmpeg.input(str(path)).audio if info.has_audio else None
     written = 0
     fps = info.fps or 30.0
-    with FrameWriter(out, info.size, fps, settings.encoding, audio, copy_audio=True) as writer:
+    h, w = info.size
+    size = (h, 2 * w) if settings.preview else (h, w)
+    with FrameWriter(out, size, fps, settings.encoding, audio, copy_audio=True) as writer:
         for frame, H in zip(read_frames(path, info=info), planned.homographies, strict=False):
-            writer.write(warp_frame(frame, H))
+            warped = warp_frame(frame, H)
+            writer.write(np.hstack([frame, warped]) if settings.preview else warped)
             written += 1
             progress(1)
     return written

@@ -164,3 +164,37 @@ def test_one_and_zero_frame_videos(shaky, tmp_path):
     result = RUNNER.invoke(app, ["run", str(silent), str(tmp_path / "o2.mp4"), "-q"])
     assert result.exit_code != 0 and "not a video" in result.output
     assert not (tmp_path / "o1.mp4").exists() and not (tmp_path / "o2.mp4").exists()
+
+
+def test_portrait_rotation_metadata_is_honoured(shaky, tmp_path):
+    rotated = tmp_path / "portrait.mp4"
+    cmd = [
+        ffmpeg_exe(),
+        "-hide_banner",
+        "-loglevel",
+        "error",
+        "-display_rotation",
+        "90",
+        "-i",
+        str(shaky),
+        "-c",
+        "copy",
+        str(rotated),
+    ]
+    subprocess.run(cmd, check=True)
+    info = probe(rotated)
+    assert info.rotation in (90, 270) and info.size == (320, 180)  # displayed upright
+    out = tmp_path / "out.mp4"
+    summary, _ = stabilize_video(rotated, out, Settings(fov=50.0))
+    result = probe(out)
+    assert result.size == (320, 180) and result.rotation == 0
+    assert summary["frames"] == 60
+
+
+def test_side_by_side_preview(shaky, tmp_path):
+    out = tmp_path / "preview.mp4"
+    result = RUNNER.invoke(app, ["run", str(shaky), str(out), "-q", "--preview", "side-by-side"])
+    assert result.exit_code == 0, result.output
+    assert probe(out).size == (180, 640)
+    left = next(read_frames(out))[:, :320].astype(float)
+    assert np.abs(left - next(read_frames(shaky)).astype(float)).mean() < 3
