@@ -41,15 +41,6 @@ def lh_line(x: float, y: float, u: float, v: float, f: float) -> tuple:
 
 
 @njit(cache=True)
-def lh_matrix(x: float, y: float, f: float) -> np.ndarray:
-    """The 2×3 matrix M with (u, v) = M (A, B, C) at pixel (x, y)."""
-    m = np.empty((2, 3))
-    m[0, 0], m[0, 1], m[0, 2] = x * y / f, -(f * f + x * x) / f, y
-    m[1, 0], m[1, 1], m[1, 2] = (f * f + y * y) / f, -x * y / f, -x
-    return m
-
-
-@njit(cache=True)
 def perspective_curve(
     px: float, py: float, qx: float, qy: float, f: float, thetas: np.ndarray, out: np.ndarray
 ) -> None:

@@ -1,28 +1,42 @@
-"""Readers for gyro log formats. Each gives a :class:`GyroLog` in rad/s and seconds."""
+"""Readers for gyro log formats. Each gives a :class:`GyroLog` in rad/s and seconds,
+in the sensor's own axes. :func:`read_gyro` detects the format from the file.
+
+* ``opencamera``: OpenCamera Sensors, ``x,y,z,t_ns`` per line, no header.
+* ``phone-cc9``: ``wx,wy,wz,t`` (rad/s, s), no header (the phone-cc9 data set).
+* ``gcsv``: Gyroflow's ``.gcsv`` v1.x: a ``GYROFLOW IMU LOG`` header of ``key,value``
+  lines (``tscale``, ``gscale``, ``orientation``, ...), then ``t,gx,gy,gz[,ax,ay,az]``.
+* ``sensorlogger``: Sensor Logger's ``Gyroscope.csv``: ``time,seconds_elapsed,z,y,x``
+  (columns read by name; ``time`` in ns).
+* ``csv``: any CSV with a header naming a time column and x, y, z rate columns; units
+  and time unit are options.
+"""
 
 from __future__ import annotations
 
+import csv
 from pathlib import Path
 
 import numpy as np
 
 from stabilize.gyro.log import GyroError, GyroLog
 
+FORMATS = ("opencamera", "phone-cc9", "gcsv", "sensorlogger", "csv")
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+RATE_UNITS = {"rad/s": 1.0, "deg/s": np.pi / 180.0}
 
-def _rows(path: Path, n_fields: int, *, skip_header: bool = False) -> list[list[float]]:
-    """Numeric CSV rows, or a GyroError naming the first bad line."""
+
+def _rows(path: Path, n_fields: int, *, start: int = 0) -> list[list[float]]:
+    """Numeric CSV rows from line ``start`` on, or a GyroError naming the first bad line."""
     if not path.is_file():
         raise GyroError(f"{path}: no such gyro log")
     rows = []
     with open(path, errors="replace") as f:
         for number, line in enumerate(f, start=1):
             line = line.strip()
-            if not line or line.startswith("#"):
+            if number <= start or not line or line.startswith("#"):
                 continue
             fields = line.split(",")
             if len(fields) != n_fields:
-                if skip_header and not rows:
-                    continue
                 raise GyroError(
                     f"{path}:{number}: expected {n_fields} comma-separated fields, "
                     f"got {len(fields)}"
@@ -30,8 +44,6 @@ def _rows(path: Path, n_fields: int, *, skip_header: bool = False) -> list[list[
             try:
                 rows.append([float(v) for v in fields])
             except ValueError:
-                if skip_header and not rows:
-                    continue
                 raise GyroError(f"{path}:{number}: not a number in {line!r}") from None
     if not rows:
         raise GyroError(f"{path}: no gyro samples")
@@ -45,10 +57,170 @@ def read_opencamera(path: str | Path) -> GyroLog:
     return GyroLog(data[:, 3] * 1e-9, data[:, :3], str(path))
 
 
+def read_phone_cc9(path: str | Path) -> GyroLog:
+    """The phone-cc9 layout: ``wx,wy,wz,t`` in rad/s and seconds, no header."""
+    path = Path(path)
+    data = np.array(_rows(path, 4))
+    return GyroLog(data[:, 3], data[:, :3], str(path))
+
+
 def read_frame_timestamps_ns(path: str | Path) -> np.ndarray:
     """OpenCamera Sensors' frame timestamps: one integer (ns) per line → seconds."""
-    path = Path(path)
-    data = np.array(_rows(path, 1))[:, 0]
+    return _frame_times(Path(path), 1e-9)
+
+
+def read_frame_timestamps_s(path: str | Path) -> np.ndarray:
+    """phone-cc9's framestamp.txt: one start-of-frame time (s) per line."""
+    return _frame_times(Path(path), 1.0)
+
+
+def _frame_times(path: Path, scale: float) -> np.ndarray:
+    data = np.array(_rows(path, 1))[:, 0] * scale
     if np.any(np.diff(data) <= 0):
         raise GyroError(f"{path}: frame times do not increase")
-    return data * 1e-9
+    return data
+
+
+def read_gcsv(path: str | Path) -> GyroLog:
+    """Gyroflow .gcsv: header fields, ``tscale`` and ``gscale``, and ``orientation``.
+
+    ``orientation`` (e.g. ``YxZ``) says which sensor axis each logged column is, a
+    lower-case letter meaning the negative axis; rates are returned in sensor axes.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise GyroError(f"{path}: no such gyro log")
+    header: dict[str, str] = {}
+    columns: list[str] = []
+    with open(path, errors="replace") as f:
+        first = f.readline().strip()
+        if not first.upper().startswith("GYROFLOW IMU LOG"):
+            raise GyroError(f"{path}:1: not a Gyroflow .gcsv (expected 'GYROFLOW IMU LOG')")
+        for number, line in enumerate(f, start=2):
+            key, _, value = line.strip().partition(",")
+            if key == "t":
+                columns = [c.strip() for c in line.strip().split(",")]
+                start = number
+                break
+            header[key.strip()] = value.strip()
+        else:
+            raise GyroError(f"{path}: no 't,gx,gy,gz' column line")
+    try:
+        tscale = float(header.get("tscale", "1"))
+        gscale = float(header.get("gscale", "1"))
+    except ValueError:
+        raise GyroError(f"{path}: tscale and gscale must be numbers") from None
+    for c in ("gx", "gy", "gz"):
+        if c not in columns:
+            raise GyroError(f"{path}:{start}: no {c} column")
+    idx = [columns.index(c) for c in ("t", "gx", "gy", "gz")]
+    data = np.array(_rows(path, len(columns), start=start))[:, idx]
+    rates = data[:, 1:] * gscale
+    rates = rates @ orientation_matrix(header.get("orientation", "XYZ"), path).T
+    return GyroLog(data[:, 0] * tscale, rates, str(path))
+
+
+def orientation_matrix(code: str, path: Path | str = "") -> np.ndarray:
+    """Matrix taking logged (gx, gy, gz) to sensor (x, y, z) for a Gyroflow code."""
+    if len(code) != 3 or sorted(code.upper()) != ["X", "Y", "Z"]:
+        raise GyroError(f"{path}: orientation must be a permutation of XYZ, got {code!r}")
+    M = np.zeros((3, 3))
+    for col, letter in enumerate(code):
+        M["XYZ".index(letter.upper()), col] = 1.0 if letter.isupper() else -1.0
+    return M
+
+
+def read_named_csv(
+    path: str | Path,
+    *,
+    time_column: str | None = None,
+    columns: tuple[str, str, str] | None = None,
+    time_unit: str = "s",
+    rate_unit: str = "rad/s",
+) -> GyroLog:
+    """A CSV with a header: the time column and x, y, z rate columns, read by name.
+
+    Sensor Logger's ``Gyroscope.csv`` (``time`` in ns, ``seconds_elapsed``, ``z,y,x``)
+    is read with its own names and units when no others are given.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise GyroError(f"{path}: no such gyro log")
+    if time_unit not in TIME_UNITS or rate_unit not in RATE_UNITS:
+        raise GyroError(
+            f"time unit must be one of {list(TIME_UNITS)}, rate unit one of {list(RATE_UNITS)}"
+        )
+    with open(path, newline="", errors="replace") as f:
+        reader = csv.reader(f)
+        names = [n.strip().lower() for n in next(reader, [])]
+        sensorlogger = {"seconds_elapsed", "x", "y", "z"} <= set(names)
+        if time_column is None:
+            time_column = (
+                "seconds_elapsed"
+                if sensorlogger
+                else _pick(names, ("t", "time", "timestamp", "t_s"))
+            )
+        axes = columns or tuple(_pick(names, (a, f"g{a}", f"gyro_{a}", f"w{a}")) for a in "xyz")
+        wanted = [time_column.lower(), *(c.lower() for c in axes)]
+        missing = [c for c in wanted if c not in names]
+        if missing:
+            raise GyroError(f"{path}:1: no column named {', '.join(missing)} (have {names})")
+        idx = [names.index(c) for c in wanted]
+        rows = []
+        for number, row in enumerate(reader, start=2):
+            if not row or not "".join(row).strip():
+                continue
+            if len(row) != len(names):
+                raise GyroError(f"{path}:{number}: expected {len(names)} fields, got {len(row)}")
+            try:
+                rows.append([float(row[i]) for i in idx])
+            except ValueError:
+                raise GyroError(f"{path}:{number}: not a number") from None
+    if not rows:
+        raise GyroError(f"{path}: no gyro samples")
+    data = np.array(rows)
+    return GyroLog(
+        data[:, 0] * TIME_UNITS[time_unit], data[:, 1:] * RATE_UNITS[rate_unit], str(path)
+    )
+
+
+def _pick(names: list[str], candidates: tuple[str, ...]) -> str:
+    for c in candidates:
+        if c in names:
+            return c
+    return candidates[0]
+
+
+def detect_format(path: str | Path) -> str:
+    """Guess the format from the first lines."""
+    path = Path(path)
+    if not path.is_file():
+        raise GyroError(f"{path}: no such gyro log")
+    with open(path, errors="replace") as f:
+        first = f.readline().strip()
+    if first.upper().startswith("GYROFLOW IMU LOG"):
+        return "gcsv"
+    fields = first.split(",")
+    try:
+        values = [float(v) for v in fields]
+    except ValueError:
+        return "csv"  # a header line: columns by name (Sensor Logger included)
+    if len(values) == 4:
+        # OpenCamera logs integer nanoseconds; phone-cc9 logs float seconds.
+        return "opencamera" if fields[3].strip().lstrip("-").isdigit() else "phone-cc9"
+    raise GyroError(f"{path}:1: unknown gyro log layout ({len(fields)} fields)")
+
+
+def read_gyro(path: str | Path, fmt: str | None = None, **options) -> GyroLog:
+    """Read a gyro log, detecting its format unless ``fmt`` is given."""
+    fmt = fmt or detect_format(path)
+    readers = {
+        "opencamera": read_opencamera,
+        "phone-cc9": read_phone_cc9,
+        "gcsv": read_gcsv,
+        "sensorlogger": read_named_csv,
+        "csv": read_named_csv,
+    }
+    if fmt not in readers:
+        raise GyroError(f"unknown gyro format {fmt!r}; choose from {', '.join(FORMATS)}")
+    return readers[fmt](path, **options)
