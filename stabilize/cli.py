@@ -340,6 +340,101 @@ def rotations(
         _fail(str(err))
 
 
+def _axes(code: str | None):
+    """'YXz' → R_cam_imu: camera x, y, z are IMU Y, X and -Z (lower case: negative)."""
+    if code is None:
+        return None
+    if len(code) != 3 or sorted(code.upper()) != ["X", "Y", "Z"]:
+        _fail(f"--axes must be three letters naming the IMU axis of camera x, y, z, got {code!r}")
+    R = np.zeros((3, 3))
+    for row, letter in enumerate(code):
+        R[row, "XYZ".index(letter.upper())] = 1.0 if letter.isupper() else -1.0
+    if np.linalg.det(R) < 0:
+        _fail(f"--axes {code} is a reflection, not a rotation")
+    return R
+
+
+@app.command(
+    epilog=(
+        "Examples:\n\n"
+        "  stabilize compare clip.mp4 --gyro gyro.csv --report cmp/\n\n"
+        "  stabilize compare 'frames/RE_frame-%d.jpg' --start-number 99 --gyro gyro.txt "
+        "--timestamps framestamp.txt --focal 573.85 --json\n\n"
+        "  stabilize compare clip.mp4 --gyro log.gcsv --offset 0.042 --axes YXz"
+    )
+)
+def compare(
+    video: str = typer.Argument(..., help="A video, or an image pattern like dir/img-%d.jpg."),
+    gyro: Path = typer.Option(..., help="The gyro log."),
+    gyro_format: str | None = typer.Option(None, help="Override the detected log format."),
+    timestamps: Path | None = typer.Option(
+        None, help="Frame times on the gyro clock (OpenCamera ns, or seconds per line)."
+    ),
+    start_number: int | None = typer.Option(None, help="First image number of a pattern."),
+    fps: float | None = typer.Option(None, help="Frame rate of an image sequence."),
+    fov: float | None = typer.Option(None, help="Horizontal field of view, deg (default 69)."),
+    focal: float | None = typer.Option(None, help="Focal length in pixels (overrides --fov)."),
+    offset: float | None = typer.Option(None, help="Gyro minus video clock, s (skip the search)."),
+    axes: str | None = typer.Option(None, help="IMU axis of camera x, y, z, e.g. YXz."),
+    search: float = typer.Option(1.0, min=0.0, help="Offset search range, ± seconds."),
+    flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
+    raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
+    report: Path | None = typer.Option(None, help="Write pairs.csv, summary.json and plots here."),
+    as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON on stdout."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar."),
+) -> None:
+    """Compare the visual rotation estimate with a gyroscope log."""
+    from stabilize import compare as cmp
+    from stabilize.gyro import GyroError, read_gyro
+    from stabilize.gyro.readers import read_frame_timestamps_ns, read_frame_timestamps_s
+    from stabilize.gyro.sync import synchronise
+    from stabilize.pipeline import estimate_rotations
+    from stabilize.progress import progress_bar
+    from stabilize.video_reader import VideoError, frame_times, probe, sequence_args
+
+    settings = _settings(flow_name, raft_weights, "cpu", fov=fov, focal=focal, max_deg=15.0)
+    R_cam_imu = _axes(axes)
+    try:
+        log = read_gyro(gyro, gyro_format)
+        args = sequence_args(video, start_number, fps)
+        info = probe(video, args)
+        n = len(frame_times(video, args))
+        times = None
+        if timestamps is not None:
+            stamps = np.loadtxt(timestamps, ndmin=1)
+            reader = read_frame_timestamps_ns if stamps[0] > 1e12 else read_frame_timestamps_s
+            stamps = reader(timestamps)
+            first = (start_number or 1) - 1 if args else 0  # line N is image N
+            times = stamps[first : first + n]
+            if len(times) < n:
+                _fail(f"{timestamps}: {len(stamps)} frame times, the video needs {first + n}")
+        with progress_bar("estimating", n - 1, quiet=quiet) as advance:
+            times, R, _support = estimate_rotations(video, info, settings, advance, times)
+        sync = synchronise(
+            log, times, R, search=(-search, search), offset=offset, R_cam_imu=R_cam_imu
+        )
+        result = cmp.compare(times, R, log, sync, settings.focal_px(info.width))
+    except (VideoError, GyroError, ValueError) as err:
+        _fail(str(err))
+    summary = result.summary()
+    if report is not None:
+        cmp.write_report(report, result)
+    if summary["warning"]:
+        typer.secho(f"WARNING: {summary['warning']}", err=True, fg="red", bold=True)
+    if as_json:
+        typer.echo(json.dumps(summary, indent=2))
+        return
+    typer.echo(
+        f"{summary['frames']} pairs: AAE {summary['aae_deg']:.4f}°, median "
+        f"{summary['median_deg']:.4f}°, p95 {summary['p95_deg']:.4f}° (pitch "
+        f"{summary['aae_pitch_deg']:.4f}°, yaw {summary['aae_yaw_deg']:.4f}°, roll "
+        f"{summary['aae_roll_deg']:.4f}°)\noffset {1000 * summary['offset_s']:+.2f} ms, gyro "
+        f"{summary['gyro_rate_hz']:.1f} Hz, focal {summary['focal_px']:.1f} px, speed "
+        f"correlation {summary['speed_correlation']:.3f}\nR_cam_imu = "
+        f"{np.round(np.array(summary['R_cam_imu']), 4).tolist()}"
+    )
+
+
 COMMANDS = ("run", "rotations", "synth", "evaluate", "compare", "batch")
 
 

@@ -81,10 +81,17 @@ def _no_progress(_: int = 1) -> None:
 
 
 def estimate_rotations(
-    path: Path, info: VideoInfo, settings: Settings, progress: Progress = _no_progress
+    path: Path,
+    info: VideoInfo,
+    settings: Settings,
+    progress: Progress = _no_progress,
+    times: NDArray | None = None,
 ) -> tuple[NDArray, NDArray, NDArray]:
-    """Pass 1: (times, R_t, support) for the clip; frames streamed at the working size."""
-    times = frame_times(path)
+    """Pass 1: (times, R_t, support) for the clip; frames streamed at the working size.
+
+    Frame times are the container's timestamps unless given (e.g. from a sensor log).
+    """
+    times = frame_times(path, info.input_args) if times is None else np.asarray(times)
     if len(times) < 2:
         raise VideoError(f"{path}: has {len(times)} frame(s); nothing to stabilise")
     ws = flow.working_size(info.size)

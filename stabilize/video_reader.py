@@ -25,7 +25,7 @@ class VideoError(ValueError):
 
 @dataclass(frozen=True)
 class VideoInfo:
-    path: Path
+    path: Path | str
     width: int  # as displayed, after the container's rotation
     height: int
     fps: float
@@ -34,6 +34,7 @@ class VideoInfo:
     has_audio: bool
     codec: str
     pix_fmt: str
+    input_args: tuple = ()  # FFmpeg input options, e.g. an image sequence's start number
 
     @property
     def size(self) -> tuple[int, int]:
@@ -46,15 +47,30 @@ _DURATION = re.compile(r"Duration: (\d+):(\d+):(\d+(?:\.\d+)?)")
 _ROTATION = re.compile(r"rotation of (-?\d+(?:\.\d+)?) degrees|rotate\s*:\s*(-?\d+)")
 
 
-def probe(path: str | Path) -> VideoInfo:
-    """What FFmpeg reports of the first video stream, or :class:`VideoError`."""
+def sequence_args(path: str | Path, start_number: int | None, fps: float | None) -> tuple:
+    """FFmpeg input options for an image sequence (a %d pattern), else none."""
+    if "%" not in str(path):
+        return ()
+    args = ("-f", "image2")
+    if start_number is not None:
+        args += ("-start_number", str(start_number))
+    return (*args, "-framerate", str(fps or 30.0))
+
+
+def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
+    """What FFmpeg reports of the first video stream, or :class:`VideoError`.
+
+    ``path`` may be an image-sequence pattern (``frames/img-%d.jpg``) with the input
+    options of :func:`sequence_args`.
+    """
+    pattern = "%" in str(path)
     path = Path(path)
-    if not path.exists():
+    if not pattern and not path.exists():
         raise VideoError(f"{path}: no such file")
     if path.is_dir():
-        raise VideoError(f"{path}: is a folder, not a video")
+        raise VideoError(f"{path}: is a folder, not a video (give a pattern like dir/img-%d.jpg)")
     result = subprocess.run(
-        [ffmpeg_exe(), "-hide_banner", "-nostdin", "-i", str(path)],
+        [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i", str(path)],
         capture_output=True,
         text=True,
         errors="replace",
@@ -76,7 +92,9 @@ def probe(path: str | Path) -> VideoInfo:
     if rotation in (90, 270):
         w, h = h, w
     has_audio = re.search(r"Stream #\S+.*?: Audio:", text) is not None
-    return VideoInfo(path, w, h, fps, duration, rotation, has_audio, codec, pix_fmt)
+    return VideoInfo(
+        path, w, h, fps, duration, rotation, has_audio, codec, pix_fmt, tuple(input_args)
+    )
 
 
 def read_frames(
@@ -89,7 +107,8 @@ def read_frames(
     """
     info = info or probe(path)
     h, w = size or info.size
-    stream = ffmpeg.input(str(path))
+    options = dict(zip(info.input_args[::2], info.input_args[1::2], strict=True))
+    stream = ffmpeg.input(str(path), **{k.lstrip("-"): v for k, v in options.items()})
     if size is not None and size != info.size:
         stream = stream.filter("scale", w, h, flags="area")
     process = (
@@ -115,7 +134,7 @@ def read_frames(
         raise VideoError(f"{path}: truncated: the file ends before its last frame")
 
 
-def frame_times(path: str | Path) -> np.ndarray:
+def frame_times(path: str | Path, input_args: tuple = ()) -> np.ndarray:
     """Presentation times (s) of every video frame, from the first, in display order.
 
     Read from the container's packets (no decoding), so variable frame rate is exact.
@@ -125,6 +144,7 @@ def frame_times(path: str | Path) -> np.ndarray:
             ffmpeg_exe(),
             "-hide_banner",
             "-nostdin",
+            *input_args,
             "-i",
             str(path),
             "-map",

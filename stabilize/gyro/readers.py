@@ -198,6 +198,8 @@ def detect_format(path: str | Path) -> str:
         raise GyroError(f"{path}: no such gyro log")
     with open(path, errors="replace") as f:
         first = f.readline().strip()
+    if not first:
+        raise GyroError(f"{path}: no gyro samples (the file is empty)")
     if first.upper().startswith("GYROFLOW IMU LOG"):
         return "gcsv"
     fields = first.split(",")

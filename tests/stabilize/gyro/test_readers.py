@@ -94,7 +94,7 @@ def test_plain_csv_with_units(tmp_path):
         ("empty.csv", "", "no gyro samples"),
         ("back.csv", "0.1,0.2,0.3,100\n0.1,0.2,0.3,50\n", "does not increase"),
         ("short.csv", "0.1,0.2,0.3,100\n0.1,0.2,200\n", r"short\.csv:2: expected 4"),
-        ("word.csv", "0.1,0.2,x,100\n0.1,0.2,0.3,200\n", r"word\.csv:1: not a number"),
+        ("word.csv", "0.1,0.2,0.3,100\n0.1,0.2,x,200\n", r"word\.csv:2: not a number"),
         ("cols.csv", "t,a,b\n0,1,2\n", "no column named"),
         ("odd.csv", "1,2,3\n", "unknown gyro log layout"),
     ],

@@ -1,0 +1,179 @@
+"""Visual rotation estimates against a gyroscope: per-pair errors, summary, plots, warning.
+
+The gyro is synchronised to the visual estimate (:mod:`stabilize.gyro.sync`), its bias
+removed, and integrated over each frame interval (:mod:`stabilize.gyro.integrate`). The
+angular error of each pair is θ(R_vis R_gyroᵀ); the AAE is their mean, as in the paper.
+
+A loud warning is raised, never a silent success, when the two disagree too much to be
+trusted: the angular speeds barely correlate (a wrong log, or a clip stabilised in the
+camera), or the error is a large share of the motion itself.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rotation import so3
+from stabilize.gyro import GyroLog, integrate_rotations
+from stabilize.gyro.sync import Sync, visual_rates
+
+MIN_CORRELATION = 0.6  # of angular speeds, below which the log does not match the video
+MAX_ERROR_SHARE = 1.0  # AAE over the mean rotation per frame: the estimate says nothing
+
+
+@dataclass(frozen=True)
+class Comparison:
+    times: NDArray  # (N,) video clock
+    visual: NDArray  # (N-1, 3, 3)
+    gyro: NDArray  # (N-1, 3, 3)
+    errors_deg: NDArray  # (N-1,)
+    sync: Sync
+    focal_px: float
+    gyro_rate_hz: float
+
+    @property
+    def rate_errors(self) -> NDArray:
+        """ω_vis - ω_gyro per pair (N-1, 3), deg/s, camera axes."""
+        return np.degrees(
+            visual_rates(self.times, self.visual) - visual_rates(self.times, self.gyro)
+        )
+
+    def axis_errors_deg(self) -> NDArray:
+        """Mean |error| about each camera axis (pitch x, yaw y, roll z), degrees."""
+        return np.degrees(np.abs(so3.log_so3(self.visual @ np.swapaxes(self.gyro, -1, -2)))).mean(0)
+
+    def warning(self) -> str | None:
+        motion = np.degrees(so3.angle(self.gyro)).mean()
+        aae = self.errors_deg.mean()
+        if self.sync.correlation < MIN_CORRELATION:
+            return (
+                f"visual and gyro motion barely agree (speed correlation "
+                f"{self.sync.correlation:.2f} < {MIN_CORRELATION}): a wrong or mismatched log, "
+                "or a clip stabilised in the camera. Do not trust these figures."
+            )
+        if aae > MAX_ERROR_SHARE * motion:
+            return (
+                f"the error ({aae:.3f}° per frame) is {100 * aae / motion:.0f}% of the motion "
+                f"itself ({motion:.3f}° per frame): the comparison is not meaningful."
+            )
+        return None
+
+    def summary(self) -> dict:
+        err = self.errors_deg
+        axes = self.axis_errors_deg()
+        rms = np.sqrt(np.mean(self.rate_errors**2, axis=0))
+        return {
+            "offset_s": self.sync.offset,
+            "aae_deg": float(err.mean()),
+            "median_deg": float(np.median(err)),
+            "p95_deg": float(np.percentile(err, 95)),
+            "aae_pitch_deg": float(axes[0]),
+            "aae_yaw_deg": float(axes[1]),
+            "aae_roll_deg": float(axes[2]),
+            "rms_rate_error_deg_s": [float(v) for v in rms],
+            "frames": int(len(err)),
+            "R_cam_imu": self.sync.R_cam_imu.tolist(),
+            "axes": axes_code(self.sync.R_cam_imu),
+            "gyro_bias_rad_s": self.sync.bias.tolist(),
+            "speed_correlation": self.sync.correlation,
+            "focal_px": self.focal_px,
+            "gyro_rate_hz": self.gyro_rate_hz,
+            "warning": self.warning(),
+        }
+
+
+def axes_code(R: NDArray) -> str:
+    """The nearest signed axis permutation as letters: the IMU axis of camera x, y, z."""
+    out = ""
+    for row in np.asarray(R):
+        k = int(np.argmax(np.abs(row)))
+        out += "XYZ"[k] if row[k] > 0 else "xyz"[k]
+    return out
+
+
+def compare(times: NDArray, visual: NDArray, log: GyroLog, sync: Sync, focal: float) -> Comparison:
+    unbiased = GyroLog(log.times, log.rates - sync.bias, log.source)
+    gyro = integrate_rotations(unbiased, times, sync.offset, sync.R_cam_imu)
+    errors = so3.angular_error_deg(visual, gyro)
+    return Comparison(np.asarray(times), visual, gyro, errors, sync, focal, log.rate_hz)
+
+
+def write_report(folder: str | Path, result: Comparison) -> None:
+    """pairs.csv, summary.json and the plots rates.png, error.png, histogram.png."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    rv, rg = so3.log_so3(result.visual), so3.log_so3(result.gyro)
+    with open(folder / "pairs.csv", "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(
+            [
+                "frame",
+                "t",
+                "vis_rx",
+                "vis_ry",
+                "vis_rz",
+                "gyro_rx",
+                "gyro_ry",
+                "gyro_rz",
+                "error_deg",
+            ]
+        )
+        for k in range(len(rv)):
+            writer.writerow(
+                [
+                    k,
+                    f"{result.times[k]:.6f}",
+                    *(f"{v:.9g}" for v in rv[k]),
+                    *(f"{v:.9g}" for v in rg[k]),
+                    f"{result.errors_deg[k]:.6f}",
+                ]
+            )
+    (folder / "summary.json").write_text(json.dumps(result.summary(), indent=2))
+    plot(folder, result)
+
+
+def plot(folder: Path, result: Comparison) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    mid = 0.5 * (result.times[1:] + result.times[:-1])
+    wv = np.degrees(visual_rates(result.times, result.visual))
+    wg = np.degrees(visual_rates(result.times, result.gyro))
+    fig, axes = plt.subplots(3, 1, figsize=(10, 7), sharex=True)
+    for ax, k, name in zip(axes, range(3), ("x (pitch)", "y (yaw)", "z (roll)"), strict=True):
+        ax.plot(mid, wg[:, k], color="0.3", lw=1.5, label="gyro")
+        ax.plot(mid, wv[:, k], color="C1", lw=1, label="visual")
+        ax.set_ylabel(f"{name} °/s")
+        ax.grid(alpha=0.3)
+    axes[0].legend(loc="upper right")
+    axes[-1].set_xlabel("video time (s)")
+    fig.suptitle(f"Angular rate, camera axes (offset {1000 * result.sync.offset:+.1f} ms)")
+    fig.tight_layout()
+    fig.savefig(folder / "rates.png", dpi=110)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(10, 3.5))
+    ax.plot(mid, result.errors_deg, color="C3")
+    ax.set_xlabel("video time (s)")
+    ax.set_ylabel("angular error (°)")
+    ax.set_title(f"Visual vs gyro: AAE {result.errors_deg.mean():.4f}°")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(folder / "error.png", dpi=110)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.hist(result.errors_deg, bins=40, color="C0")
+    ax.set_xlabel("angular error (°)")
+    ax.set_ylabel("frame pairs")
+    fig.tight_layout()
+    fig.savefig(folder / "histogram.png", dpi=110)
+    plt.close(fig)
