@@ -144,7 +144,7 @@ def plot(folder: Path, result: Comparison) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    mid = 0.5 * (result.times[1:] + result.times[:-1])
+    mid = 0.5 * (result.times[1:] + result.times[:-1]) - result.times[0]
     wv = np.degrees(visual_rates(result.times, result.visual))
     wg = np.degrees(visual_rates(result.times, result.gyro))
     fig, axes = plt.subplots(3, 1, figsize=(10, 7), sharex=True)
@@ -154,7 +154,7 @@ def plot(folder: Path, result: Comparison) -> None:
         ax.set_ylabel(f"{name} °/s")
         ax.grid(alpha=0.3)
     axes[0].legend(loc="upper right")
-    axes[-1].set_xlabel("video time (s)")
+    axes[-1].set_xlabel("time from the first frame (s)")
     fig.suptitle(f"Angular rate, camera axes (offset {1000 * result.sync.offset:+.1f} ms)")
     fig.tight_layout()
     fig.savefig(folder / "rates.png", dpi=110)
@@ -162,7 +162,7 @@ def plot(folder: Path, result: Comparison) -> None:
 
     fig, ax = plt.subplots(figsize=(10, 3.5))
     ax.plot(mid, result.errors_deg, color="C3")
-    ax.set_xlabel("video time (s)")
+    ax.set_xlabel("time from the first frame (s)")
     ax.set_ylabel("angular error (°)")
     ax.set_title(f"Visual vs gyro: AAE {result.errors_deg.mean():.4f}°")
     ax.grid(alpha=0.3)
