@@ -253,6 +253,13 @@ def run(
     preview: str = typer.Option(
         "none", help="side-by-side: the original and the stabilised clip next to each other."
     ),
+    gyro: Path | None = typer.Option(
+        None, help="Stabilise from this gyro log (synchronised to the video) instead."
+    ),
+    gyro_format: str | None = typer.Option(None, help="Override the detected log format."),
+    gyro_offset: float | None = typer.Option(None, help="Gyro minus video clock, s."),
+    gyro_axes: str | None = typer.Option(None, help="IMU axis of camera x, y, z, e.g. YXz."),
+    gyro_lpf: float | None = typer.Option(None, help="Low-pass the gyro at this many Hz."),
     overwrite: bool = typer.Option(False, help="Replace OUT if it exists."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar."),
     as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON on stdout."),
@@ -277,6 +284,11 @@ def run(
         crop=crop,
         preview=preview == "side-by-side",
         encoding=Encoding(codec=codec, crf=crf, preset=preset),
+        gyro=str(gyro) if gyro else None,
+        gyro_format=gyro_format,
+        gyro_offset=gyro_offset,
+        gyro_axes=None if gyro_axes is None else tuple(map(tuple, _axes(gyro_axes))),
+        gyro_lpf=gyro_lpf,
     )
     with contextlib.ExitStack() as stack:
 
@@ -307,12 +319,18 @@ def run(
     epilog=(
         "Examples:\n\n"
         "  stabilize rotations clip.mp4 -o rotations.csv\n\n"
+        "  stabilize rotations clip.mp4 --gcsv clip.gcsv     # for Gyroflow\n\n"
         "  stabilize rotations clip.mp4 -o rot.csv --flow raft --raft-weights raft-small.pth"
     )
 )
 def rotations(
     input_path: Path = typer.Argument(..., metavar="IN", help="A video."),
-    output: Path = typer.Option(..., "-o", "--output", help="CSV: frame,t,rx,ry,rz,support."),
+    output: Path | None = typer.Option(
+        None, "-o", "--output", help="CSV: frame,t,rx,ry,rz,support."
+    ),
+    gcsv: Path | None = typer.Option(
+        None, help="Also (or only) write the rates as a Gyroflow .gcsv, for clips with no gyro."
+    ),
     flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
     raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
     device: str = typer.Option("cpu", help="cpu or cuda (for RAFT)."),
@@ -329,13 +347,21 @@ def rotations(
     from stabilize.rotation_files import write_rotations
     from stabilize.video_reader import VideoError, probe
 
+    if output is None and gcsv is None:
+        _fail("give -o rotations.csv and/or --gcsv out.gcsv")
     settings = _settings(flow_name, raft_weights, device, fov=fov, focal=focal)
     try:
         info = probe(input_path)
         with progress_bar("estimating", None, quiet=quiet) as advance:
             times, R, support = estimate_rotations(input_path, info, settings, advance)
-        with atomic_output(output, overwrite=overwrite) as tmp:
-            write_rotations(tmp, times[:-1], so3.log_so3(R), support)
+        if output is not None:
+            with atomic_output(output, overwrite=overwrite) as tmp:
+                write_rotations(tmp, times[:-1], so3.log_so3(R), support)
+        if gcsv is not None:
+            from stabilize.gyro.export import write_gcsv
+
+            with atomic_output(gcsv, overwrite=overwrite) as tmp:
+                write_gcsv(tmp, times, R)
     except (VideoError, ValueError, FileExistsError, RuntimeError) as err:
         _fail(str(err))
 

@@ -51,6 +51,11 @@ class Settings:
     crop: str = "auto"
     max_deg: float = 15.0
     preview: bool = False  # write original | stabilised side by side
+    gyro: str | None = None  # a gyro log: the path comes from it, synchronised to the video
+    gyro_format: str | None = None
+    gyro_offset: float | None = None
+    gyro_axes: tuple | None = None  # R_cam_imu as nested tuples
+    gyro_lpf: float | None = None  # Hz
     encoding: Encoding = field(default_factory=Encoding)
 
     def focal_px(self, width: int) -> float:
@@ -191,6 +196,25 @@ def render(
     return written
 
 
+def _from_gyro(settings: Settings, times: NDArray, R_visual: NDArray) -> tuple[NDArray, dict]:
+    """R_t from the gyro log named in settings, synchronised against the visual estimate."""
+    from stabilize.gyro import read_gyro
+    from stabilize.gyro.source import gyro_rotations, lowpass
+
+    log = read_gyro(settings.gyro, settings.gyro_format)
+    if settings.gyro_lpf:
+        log = lowpass(log, settings.gyro_lpf)
+    axes = None if settings.gyro_axes is None else np.array(settings.gyro_axes, dtype=float)
+    R, sync = gyro_rotations(log, times, R_visual, offset=settings.gyro_offset, R_cam_imu=axes)
+    return R, {
+        "log": str(settings.gyro),
+        "offset_s": sync.offset,
+        "R_cam_imu": sync.R_cam_imu.tolist(),
+        "speed_correlation": sync.correlation,
+        "rate_hz": log.rate_hz,
+    }
+
+
 def stabilize_video(
     input_path: str | os.PathLike,
     output_path: str | os.PathLike,
@@ -211,6 +235,9 @@ def stabilize_video(
     start = time.perf_counter()
     bar = progress or (lambda label, total: _no_progress)
     times, R, support = estimate_rotations(src, info, settings, bar("estimating", None))
+    gyro_summary = None
+    if settings.gyro:
+        R, gyro_summary = _from_gyro(settings, times, R)
     t_estimate = time.perf_counter() - start
     K = intrinsics(settings.focal_px(info.width), info.size)
     planned = plan(times, R, support, K, info.size, settings)
@@ -235,5 +262,6 @@ def stabilize_video(
         },
         "fps": frames / total,
         "settings": {k: v for k, v in asdict(settings).items() if k != "encoding"},
+        "gyro": gyro_summary,
     }
     return summary, planned

@@ -1,0 +1,84 @@
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from rotation import so3
+from stabilize.cli import app
+from stabilize.gyro import GyroError, GyroLog, read_gyro
+from stabilize.gyro.export import write_gcsv
+from stabilize.gyro.source import lowpass
+from stabilize.gyro.sync import visual_rates
+
+SAMPLE = Path(__file__).resolve().parents[3] / "samples" / "street"
+
+
+def test_gcsv_export_round_trips_through_the_reader(tmp_path):
+    times = np.arange(6) / 30.0
+    R = so3.exp_so3(np.array([[0.01, -0.02, 0.005]] * 5))
+    write_gcsv(tmp_path / "v.gcsv", times, R)
+    log = read_gyro(tmp_path / "v.gcsv")
+    np.testing.assert_allclose(log.rates, visual_rates(times, R), atol=1e-8)
+    np.testing.assert_allclose(log.times, 0.5 * (times[1:] + times[:-1]), atol=1e-6)
+
+
+def test_lowpass_removes_high_frequencies():
+    t = np.arange(0, 2, 1 / 400)
+    slow, fast = np.sin(2 * np.pi * 2 * t), np.sin(2 * np.pi * 80 * t)
+    log = GyroLog(t, np.stack([slow + fast] * 3, -1), "test")
+    out = lowpass(log, 20.0)
+    assert np.abs(out.rates[100:-100, 0] - slow[100:-100]).max() < 0.05
+    with pytest.raises(GyroError, match="between"):
+        lowpass(log, 500.0)
+
+
+def test_stabilising_from_the_gyro(tmp_path):
+    out = tmp_path / "gyro.mp4"
+    result = CliRunner().invoke(
+        app,
+        [
+            "run",
+            str(SAMPLE / "clip.mp4"),
+            str(out),
+            "--gyro",
+            str(SAMPLE / "gyro.csv"),
+            "--fov",
+            "70",
+            "--gyro-lpf",
+            "40",
+            "-q",
+            "--json",
+        ],
+    )
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output)
+    assert abs(summary["gyro"]["offset_s"] - 0.35) < 1e-3
+    assert summary["frames"] == 90 and out.is_file()
+
+
+def test_a_mismatched_gyro_is_refused(tmp_path):
+    rng = np.random.default_rng(1)
+    t = np.arange(0, 5, 1 / 400)
+    path = tmp_path / "noise.csv"
+    path.write_text(
+        "".join(
+            f"{x},{y},{z},{round(s * 1e9)}\n"
+            for (x, y, z), s in zip(rng.normal(0, 0.3, (len(t), 3)), t, strict=True)
+        )
+    )
+    out = tmp_path / "o.mp4"
+    result = CliRunner().invoke(
+        app, ["run", str(SAMPLE / "clip.mp4"), str(out), "--gyro", str(path), "-q"]
+    )
+    assert result.exit_code != 0 and "does not match" in result.output
+    assert not out.exists()
+
+
+def test_rotations_gcsv_option(tmp_path):
+    result = CliRunner().invoke(
+        app, ["rotations", str(SAMPLE / "clip.mp4"), "--gcsv", str(tmp_path / "c.gcsv"), "-q"]
+    )
+    assert result.exit_code == 0, result.output
+    assert read_gyro(tmp_path / "c.gcsv").rates.shape == (89, 3)
