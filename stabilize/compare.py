@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 from rotation import so3
 from stabilize.gyro import GyroLog, integrate_rotations
-from stabilize.gyro.sync import Sync, visual_rates
+from stabilize.gyro.sync import IntervalRates, Sync, visual_rates
 
 MIN_CORRELATION = 0.6  # of angular speeds, below which the log does not match the video
 MAX_ERROR_SHARE = 1.0  # AAE over the mean rotation per frame: the estimate says nothing
@@ -98,6 +98,11 @@ def axes_code(R: NDArray) -> str:
 
 
 def compare(times: NDArray, visual: NDArray, log: GyroLog, sync: Sync, focal: float) -> Comparison:
+    """Pairs inside the log's span are compared (camera logs often stop before the video)."""
+    times = np.asarray(times)
+    inside = IntervalRates(log).covered(times, sync.offset)
+    first, last = np.flatnonzero(inside)[[0, -1]]
+    times, visual = times[first : last + 2], visual[first : last + 1]
     unbiased = GyroLog(log.times, log.rates - sync.bias, log.source)
     gyro = integrate_rotations(unbiased, times, sync.offset, sync.R_cam_imu)
     errors = so3.angular_error_deg(visual, gyro)

@@ -9,6 +9,7 @@ in the sensor's own axes. :func:`read_gyro` detects the format from the file.
   (columns read by name; ``time`` in ns).
 * ``csv``: any CSV with a header naming a time column and x, y, z rate columns; units
   and time unit are options.
+* ``telemetry``: gyro embedded in a camera's video file, read by ``telemetry-parser``.
 """
 
 from __future__ import annotations
@@ -20,7 +21,8 @@ import numpy as np
 
 from stabilize.gyro.log import GyroError, GyroLog
 
-FORMATS = ("opencamera", "phone-cc9", "gcsv", "sensorlogger", "csv")
+FORMATS = ("opencamera", "phone-cc9", "gcsv", "sensorlogger", "csv", "telemetry")
+VIDEO_SUFFIXES = {".mp4", ".mov", ".insv", ".360", ".mxf", ".mkv", ".braw", ".lrv", ".m4v"}
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 RATE_UNITS = {"rad/s": 1.0, "deg/s": np.pi / 180.0}
 
@@ -191,9 +193,37 @@ def _pick(names: list[str], candidates: tuple[str, ...]) -> str:
     return candidates[0]
 
 
-def detect_format(path: str | Path) -> str:
-    """Guess the format from the first lines."""
+def read_telemetry(path: str | Path) -> GyroLog:
+    """Gyro embedded in a camera's file (GoPro GPMF, Sony, Insta360, DJI, Google CAMM, ...),
+    through the optional ``telemetry-parser`` package; times on the video's timeline."""
     path = Path(path)
+    try:
+        import telemetry_parser
+    except ImportError:
+        raise GyroError(
+            "reading camera-embedded telemetry needs the 'telemetry' extra: "
+            "pip install 'hough-stabilize[telemetry]' (the telemetry-parser package)"
+        ) from None
+    if not path.is_file():
+        raise GyroError(f"{path}: no such file")
+    try:
+        samples = telemetry_parser.Parser(str(path)).normalized_imu()
+    except Exception as err:  # the parser raises its own types
+        raise GyroError(f"{path}: no readable camera telemetry ({err})") from None
+    rows = [(s["timestamp_ms"], *s["gyro"]) for s in samples if s.get("gyro") is not None]
+    if len(rows) < 2:
+        raise GyroError(f"{path}: no gyro samples in the camera telemetry")
+    data = np.array(rows, dtype=np.float64)
+    _, keep = np.unique(data[:, 0], return_index=True)  # repeated stamps at block joins
+    data = data[np.sort(keep)]
+    return GyroLog(data[:, 0] * 1e-3, np.radians(data[:, 1:]), str(path))
+
+
+def detect_format(path: str | Path) -> str:
+    """Guess the format from the suffix (camera files) or the first lines."""
+    path = Path(path)
+    if path.suffix.lower() in VIDEO_SUFFIXES:
+        return "telemetry"
     if not path.is_file():
         raise GyroError(f"{path}: no such gyro log")
     with open(path, errors="replace") as f:
@@ -222,6 +252,7 @@ def read_gyro(path: str | Path, fmt: str | None = None, **options) -> GyroLog:
         "gcsv": read_gcsv,
         "sensorlogger": read_named_csv,
         "csv": read_named_csv,
+        "telemetry": read_telemetry,
     }
     if fmt not in readers:
         raise GyroError(f"unknown gyro format {fmt!r}; choose from {', '.join(FORMATS)}")

@@ -26,6 +26,7 @@ from rotation import so3
 from stabilize.gyro.log import GyroError, GyroLog
 
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
+MIN_COVERAGE = 0.8  # share of the frame pairs the log must cover (camera logs stop early)
 
 
 @dataclass(frozen=True)
@@ -62,14 +63,23 @@ class IntervalRates:
         self.integral = np.vstack([np.zeros(3), np.cumsum(steps, axis=0)])
 
     def __call__(self, times: NDArray, offset: float) -> NDArray[np.float64]:
-        """(N-1, 3) mean ω_imu over [t_k, t_{k+1}] shifted onto the gyro clock."""
+        """(N-1, 3) mean ω_imu over [t_k, t_{k+1}] shifted onto the gyro clock; NaN rows
+        for intervals the log does not cover."""
         g = np.asarray(times) + offset
         I = np.stack([np.interp(g, self.log.times, self.integral[:, a]) for a in range(3)], -1)
-        return np.diff(I, axis=0) / np.diff(times)[:, None]
+        rates = np.diff(I, axis=0) / np.diff(times)[:, None]
+        rates[~self.covered(times, offset)] = np.nan
+        return rates
+
+    def covered(self, times: NDArray, offset: float) -> NDArray[np.bool_]:
+        """Which frame intervals lie inside the log at this offset."""
+        lo, hi = self.log.span
+        g = np.asarray(times) + offset
+        return (g[:-1] >= lo) & (g[1:] <= hi)
 
     def covers(self, times: NDArray, offset: float) -> bool:
-        lo, hi = self.log.span
-        return times[0] + offset >= lo and times[-1] + offset <= hi
+        """Whether enough of the clip (MIN_COVERAGE) lies inside the log."""
+        return bool(self.covered(times, offset).mean() >= MIN_COVERAGE)
 
 
 def coarse_offset(
@@ -82,7 +92,8 @@ def coarse_offset(
         if not gyro.covers(times, delta):
             continue
         speed = np.linalg.norm(gyro(times, delta), axis=1)
-        r = np.corrcoef(speed_vis, speed)[0, 1]
+        ok = np.isfinite(speed)
+        r = np.corrcoef(speed_vis[ok], speed[ok])[0, 1]
         if np.isfinite(r) and r > best[1]:
             best = (float(delta), float(r))
     if not np.isfinite(best[1]):
@@ -99,6 +110,8 @@ def fit_axes(w_vis: NDArray, w_imu: NDArray, R: NDArray | None = None) -> tuple[
 
     Without a given R: the best signed permutation, then Kabsch on centred rates.
     """
+    ok = np.isfinite(w_imu).all(axis=1)
+    w_vis, w_imu = w_vis[ok], w_imu[ok]
     if R is None:
         costs = [np.sum((w_vis - w_imu @ P.T) ** 2) for P in signed_permutations()]
         R = signed_permutations()[int(np.argmin(costs))]
@@ -121,7 +134,7 @@ def refine_offset(
     def cost(delta: float) -> float:
         if not gyro.covers(times, delta):
             return np.inf
-        return float(np.sum((w_vis - (gyro(times, delta) - bias) @ R.T) ** 2))
+        return float(np.nanmean((w_vis - (gyro(times, delta) - bias) @ R.T) ** 2))
 
     a, b = start - 0.005, start + 0.005
     c, d = b - GOLDEN * (b - a), a + GOLDEN * (b - a)
@@ -162,11 +175,9 @@ def synchronise(
             raise GyroError(
                 f"{log.source}: the gyro log does not cover the video at offset {delta:+.3f} s"
             )
-        corr = float(
-            np.corrcoef(np.linalg.norm(w_vis, axis=1), np.linalg.norm(gyro(times, delta), axis=1))[
-                0, 1
-            ]
-        )
+        speed = np.linalg.norm(gyro(times, delta), axis=1)
+        ok = np.isfinite(speed)
+        corr = float(np.corrcoef(np.linalg.norm(w_vis, axis=1)[ok], speed[ok])[0, 1])
     R, bias = fit_axes(w_vis, gyro(times, delta), R_cam_imu)
     if offset is None:
         for _ in range(2):
