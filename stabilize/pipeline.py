@@ -131,6 +131,34 @@ def estimate_rotations(
     return times, np.array(rotations), np.array(support)
 
 
+MIN_SUPPORT = 0.03  # below this share of agreeing vectors a frame's rotation is a guess
+RELATIVE_SUPPORT = 0.35  # ...or below this fraction of the clip's median support
+REPAIR_WINDOW = 3  # frames on each side whose rotations stand in for an unreliable one
+
+
+def repair_unreliable(R: NDArray, support: NDArray) -> tuple[NDArray, NDArray]:
+    """Replace the rotations that too few flow vectors agreed on.
+
+    A close moving subject can fill the frame and win the vote with a handful of
+    vectors; one such frame is a jump in the path that the smoothing then has to zoom
+    around. Its rotation is replaced by the mean rotation vector of the reliable frames
+    within ``REPAIR_WINDOW`` (or the nearest reliable one). Returns (R, reliable mask).
+    """
+    support = np.asarray(support)
+    reliable = support >= max(MIN_SUPPORT, RELATIVE_SUPPORT * float(np.median(support)))
+    if reliable.all() or not reliable.any():
+        return R, np.ones(len(R), bool)
+    rotvecs = so3.log_so3(R)
+    good = np.flatnonzero(reliable)
+    out = rotvecs.copy()
+    for k in np.flatnonzero(~reliable):
+        near = good[np.abs(good - k) <= REPAIR_WINDOW]
+        if near.size == 0:
+            near = good[[np.argmin(np.abs(good - k))]]
+        out[k] = rotvecs[near].mean(axis=0)
+    return so3.exp_so3(out), reliable
+
+
 def plan(
     times: NDArray,
     rotations: NDArray,
@@ -238,6 +266,8 @@ def stabilize_video(
     gyro_summary = None
     if settings.gyro:
         R, gyro_summary = _from_gyro(settings, times, R)
+    else:
+        R, reliable = repair_unreliable(R, support)
     t_estimate = time.perf_counter() - start
     K = intrinsics(settings.focal_px(info.width), info.size)
     planned = plan(times, R, support, K, info.size, settings)
@@ -253,6 +283,7 @@ def stabilize_video(
         "focal_px": float(K[0, 0]),
         "zoom": float(planned.zoom.max()),
         "mean_support": float(np.mean(support)),
+        "repaired_frames": 0 if settings.gyro else int((~reliable).sum()),
         "mean_rotation_deg": float(np.degrees(so3.angle(R)).mean()),
         "seconds": {
             "estimate": t_estimate,

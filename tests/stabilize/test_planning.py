@@ -1,0 +1,84 @@
+"""The path planning pieces: smoothing on SO(3), the zoom budget, warps, repairs."""
+
+import numpy as np
+import pytest
+
+from rotation import so3
+from rotation.camera import intrinsics
+from stabilize.pipeline import Settings, choose_zoom, plan, repair_unreliable
+from stabilize.smoothing import orientations_from_rotations, smooth_orientations
+from stabilize.warping import covers, homography, required_zoom
+
+K = intrinsics(500.0, (360, 640))
+SIZE = (360, 640)
+
+
+def shaky_path(n=120, seed=0, shake_deg=1.0, pan_deg_s=0.0):
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / 30.0
+    angles = np.radians(shake_deg) * rng.normal(size=(n, 3))
+    angles[:, 1] += np.radians(pan_deg_s) * t
+    O = so3.exp_so3(-angles)  # world → camera
+    return t, O
+
+
+def test_orientations_chain_the_rotations():
+    R = so3.random_rotations(np.random.default_rng(1), 5, 2.0)
+    O = orientations_from_rotations(R)
+    np.testing.assert_allclose(O[3] @ O[2].T, R[2], atol=1e-12)
+    np.testing.assert_allclose(O[0], np.eye(3))
+
+
+def test_gaussian_smoothing_removes_shake_and_keeps_a_pan():
+    t, O = shaky_path(pan_deg_s=10.0)
+    S = smooth_orientations(O, t, 0.5, "gaussian")
+    jitter = lambda P: np.degrees(so3.angle(P[1:] @ np.swapaxes(P[:-1], -1, -2))).std()  # noqa: E731
+    assert jitter(S) < 0.1 * jitter(O)
+    yaw = np.degrees(so3.log_so3(np.swapaxes(S, -1, -2))[:, 1])
+    assert yaw[-10] - yaw[10] == pytest.approx(10.0 * (t[-10] - t[10]), rel=0.15)
+
+
+def test_lock_holds_one_orientation():
+    t, O = shaky_path()
+    S = smooth_orientations(O, t, method="lock")
+    assert np.allclose(S, S[0])
+
+
+def test_zoom_of_identity_and_of_a_turn():
+    assert required_zoom(K, np.eye(3), SIZE) == 1.0
+    turn = so3.exp_so3([0.0, np.radians(3.0), 0.0])
+    z = required_zoom(K, turn, SIZE)
+    assert 1.0 < z < 1.5
+    assert covers(K, turn, z + 1e-6, SIZE) and not covers(K, turn, z - 1e-3, SIZE)
+    H = homography(K, np.eye(3), 2.0)
+    np.testing.assert_allclose(H @ [K[0, 2], K[1, 2], 1.0], [K[0, 2], K[1, 2], 1.0])
+
+
+@pytest.mark.parametrize("crop", ["auto", "dynamic"])
+def test_the_zoom_budget_is_never_broken(crop):
+    t, O = shaky_path(shake_deg=2.0)
+    R = O[1:] @ np.swapaxes(O[:-1], -1, -2)
+    planned = plan(t, R, np.ones(len(R)), K, SIZE, Settings(max_zoom=1.1, crop=crop, smooth=1.0))
+    assert planned.zoom.max() <= 1.1 + 1e-9
+    C = planned.smooth @ np.swapaxes(planned.raw, -1, -2)
+    assert all(covers(K, c, z + 1e-6, SIZE) for c, z in zip(C, planned.zoom, strict=True))
+
+
+def test_dynamic_zoom_is_smooth_and_never_below_the_need():
+    t = np.arange(60) / 30.0
+    need = np.ones(60)
+    need[30] = 1.3
+    z = choose_zoom(need, t, Settings(crop="dynamic", smooth=0.3))
+    assert np.all(z >= need) and z[30] == pytest.approx(1.3)
+    assert np.abs(np.diff(z)).max() < 0.05
+
+
+def test_unreliable_frames_are_repaired_from_their_neighbours():
+    rv = np.tile([0.01, 0.0, 0.0], (9, 1))
+    rv[4] = [0.0, 0.08, 0.0]  # a spike that few vectors voted for
+    support = np.full(9, 0.2)
+    support[4] = 0.01
+    R, reliable = repair_unreliable(so3.exp_so3(rv), support)
+    assert not reliable[4] and reliable.sum() == 8
+    np.testing.assert_allclose(so3.log_so3(R[4]), [0.01, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(so3.log_so3(R[0]), rv[0], atol=1e-12)
