@@ -461,6 +461,89 @@ def compare(
     )
 
 
+@app.command(
+    epilog=(
+        "Examples:\n\n"
+        "  stabilize batch trip/ trip-steady/\n\n"
+        "  stabilize batch phone/ out/ --recursive --pattern '*.mp4' --workers 2\n\n"
+        "  stabilize batch clips/ out/ --gyro auto      # uses clip.gcsv / clip.csv beside clip.mp4"
+    )
+)
+def batch(
+    in_dir: Path = typer.Argument(..., help="Folder of clips."),
+    out_dir: Path = typer.Argument(..., help="Where the stabilised clips go (same tree)."),
+    workers: int | None = typer.Option(None, min=1, help="Parallel files (default: per core)."),
+    pattern: str = typer.Option("*", help="Which files, as a glob."),
+    recursive: bool = typer.Option(False, help="Descend into subfolders."),
+    gyro: str | None = typer.Option(None, help="'auto': use a gyro log with the same base name."),
+    flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
+    raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
+    fov: float | None = typer.Option(None, help="Horizontal field of view, deg (default 69)."),
+    focal: float | None = typer.Option(None, help="Focal length in pixels (overrides --fov)."),
+    smooth: float = typer.Option(0.5, min=0.01, help="Smoothing time constant, s."),
+    method: str = typer.Option("adaptive", help="adaptive or gaussian."),
+    lock: bool = typer.Option(False, help="Hold one orientation, like a tripod."),
+    max_zoom: float = typer.Option(1.5, min=1.0, help="Never zoom in more than this."),
+    crop: str = typer.Option("auto", help="auto, dynamic or none."),
+    codec: str = typer.Option("libx264", help="libx264 or libx265."),
+    crf: int = typer.Option(18, min=0, max=51, help="Encoder quality."),
+    preset: str = typer.Option("medium", help="Encoder speed preset."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar."),
+) -> None:
+    """Stabilise every clip in a folder: resumable, one failure never stops the rest."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from stabilize.batch import find_jobs, run_batch
+    from stabilize.progress import progress_bar
+    from stabilize.video_writer import Encoding
+
+    if not in_dir.is_dir():
+        _fail(f"{in_dir}: not a folder")
+    if gyro not in (None, "auto"):
+        _fail("--gyro in batch mode takes 'auto' (a sidecar log per clip)")
+    settings = _settings(
+        flow_name,
+        raft_weights,
+        "cpu",
+        fov=fov,
+        focal=focal,
+        smooth=smooth,
+        method="lock" if lock else method,
+        max_zoom=max_zoom,
+        crop=crop,
+        encoding=Encoding(codec=codec, crf=crf, preset=preset),
+    )
+    jobs = find_jobs(in_dir, out_dir, pattern, recursive, gyro_auto=gyro == "auto")
+    if not jobs:
+        _fail(f"{in_dir}: no files match {pattern!r}")
+    console = Console(stderr=True)
+    with progress_bar("files", len(jobs), unit="files", quiet=quiet) as advance:
+
+        def done(row: dict) -> None:
+            advance(1)
+            if not quiet:
+                console.print(f"{row['status']:8s} {row['input']}  {row.get('error', '')}")
+
+        rows = run_batch(jobs, out_dir, settings, workers, done)
+    table = Table(title=f"{len(rows)} files → {out_dir}")
+    for column in ("input", "status", "seconds", "zoom", "error"):
+        table.add_column(column)
+    for row in rows:
+        zoom = f"{row['zoom']:.3f}" if row.get("zoom") else ""
+        table.add_row(
+            row["input"], row["status"], f"{row.get('seconds', 0):.1f}", zoom, row.get("error", "")
+        )
+    if not quiet:
+        console.print(table)
+    failed = sum(row["status"] == "failed" for row in rows)
+    if failed:
+        typer.echo(
+            f"{failed} of {len(rows)} files failed (see {out_dir / 'manifest.json'})", err=True
+        )
+        raise typer.Exit(1)
+
+
 COMMANDS = ("run", "rotations", "synth", "evaluate", "compare", "batch")
 
 

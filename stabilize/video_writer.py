@@ -18,6 +18,7 @@ class Encoding:
     crf: int = 18
     preset: str = "medium"
     pix_fmt: str = "yuv420p"
+    threads: int = 0  # encoder threads; 0 lets the encoder choose (all cores)
 
 
 class FrameWriter:
@@ -53,6 +54,8 @@ class FrameWriter:
             "format": "mp4",
             "movflags": "+faststart",
         }
+        if encoding.threads:
+            options["threads"] = encoding.threads
         if audio is not None and copy_audio:
             options.update(acodec="copy")
         elif audio is not None:

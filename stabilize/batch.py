@@ -1,0 +1,204 @@
+"""Stabilising a folder of clips: worker processes, a manifest, resume, isolated failures.
+
+Every input gets a row in ``OUT_DIR/manifest.json`` (and ``manifest.csv``): its status
+(``done``, ``skipped`` or ``failed``), seconds, output path, error, and the key quality
+figures. The manifest is rewritten after every file, and an output only ever appears under
+its final name once complete (the pipeline writes atomically), so a run that is killed can
+simply be started again: inputs whose output is complete and whose size and modification
+time match the manifest are skipped.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import multiprocessing as mp
+import os
+import time
+from collections.abc import Callable, Iterator
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from stabilize.ffmpeg_tools import atomic_output
+
+MANIFEST = "manifest.json"
+GYRO_SIDECARS = (".gcsv", ".csv", ".txt")
+BYTES_PER_WORKER = 1.5 * 2**30  # the pipeline's peak at 1080p, with headroom
+
+
+@dataclass(frozen=True)
+class Job:
+    input: str  # relative to the input folder
+    source: str  # absolute paths
+    output: str
+    size: int
+    mtime: float
+    gyro: str | None = None
+
+
+def find_jobs(
+    in_dir: Path,
+    out_dir: Path,
+    pattern: str = "*",
+    recursive: bool = False,
+    gyro_auto: bool = False,
+) -> list[Job]:
+    """One job per matching file, the output mirroring its place in the input tree."""
+    in_dir, out_dir = Path(in_dir).resolve(), Path(out_dir).resolve()
+    paths = in_dir.rglob(pattern) if recursive else in_dir.glob(pattern)
+    jobs = []
+    for path in sorted(p for p in paths if p.is_file()):
+        if out_dir in path.parents or path.name.startswith("."):
+            continue
+        if gyro_auto and path.suffix.lower() in GYRO_SIDECARS:
+            continue  # a sidecar, not a clip
+        rel = path.relative_to(in_dir)
+        sidecar = next(
+            (
+                path.with_suffix(s)
+                for s in GYRO_SIDECARS
+                if gyro_auto and path.with_suffix(s).is_file()
+            ),
+            None,
+        )
+        stat = path.stat()
+        jobs.append(
+            Job(
+                str(rel),
+                str(path),
+                str(out_dir / rel),
+                stat.st_size,
+                stat.st_mtime,
+                str(sidecar) if sidecar else None,
+            )
+        )
+    return jobs
+
+
+def load_manifest(out_dir: Path) -> dict[str, dict]:
+    path = Path(out_dir) / MANIFEST
+    if not path.is_file():
+        return {}
+    try:
+        rows = json.loads(path.read_text())
+    except json.JSONDecodeError:
+        return {}  # a damaged manifest: redo everything rather than trust it
+    return {row["input"]: row for row in rows}
+
+
+def write_manifest(out_dir: Path, rows: dict[str, dict]) -> None:
+    out_dir = Path(out_dir)
+    ordered = [rows[k] for k in sorted(rows)]
+    with atomic_output(out_dir / MANIFEST, overwrite=True) as tmp:
+        tmp.write_text(json.dumps(ordered, indent=2))
+    fields = ["input", "status", "seconds", "output", "error", "mean_support", "zoom", "frames"]
+    with atomic_output(out_dir / "manifest.csv", overwrite=True) as tmp:
+        with open(tmp, "w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+            writer.writeheader()
+            writer.writerows(ordered)
+
+
+def is_complete(job: Job, row: dict | None) -> bool:
+    """Done before, from this very input, and the output is still there."""
+    return (
+        row is not None
+        and row.get("status") in ("done", "skipped")
+        and row.get("size") == job.size
+        and row.get("mtime") == job.mtime
+        and Path(job.output).is_file()
+    )
+
+
+def _limit_threads(threads: int) -> None:
+    """Bound each worker's threads (numba, BLAS, OpenCV), so N workers share the cores."""
+    for var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS"):
+        os.environ[var] = str(threads)
+    import cv2
+
+    cv2.setNumThreads(threads)
+
+
+def run_job(job: Job, settings) -> dict:
+    """Stabilise one file; never raises: a failure is a row with its error."""
+    from stabilize.pipeline import stabilize_video
+
+    start = time.perf_counter()
+    row = {"input": job.input, "output": job.output, "size": job.size, "mtime": job.mtime}
+    try:
+        if job.gyro:
+            settings = replace(settings, gyro=job.gyro)
+        summary, _ = stabilize_video(job.source, job.output, settings, overwrite=True)
+        row.update(
+            status="done",
+            error="",
+            frames=summary["frames"],
+            zoom=summary["zoom"],
+            mean_support=summary["mean_support"],
+        )
+    except Exception as err:  # isolate every failure: one bad file must not stop the rest
+        message = str(err).splitlines()[0] if str(err) else type(err).__name__
+        row.update(status="failed", error=message)
+    row["seconds"] = round(time.perf_counter() - start, 3)
+    return row
+
+
+def default_workers() -> int:
+    """One per core, as long as memory allows a 1080p clip each."""
+    cores = os.cpu_count() or 1
+    try:
+        memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError):
+        return cores
+    return max(1, min(cores, int(memory // BYTES_PER_WORKER)))
+
+
+def run_batch(
+    jobs: list[Job],
+    out_dir: Path,
+    settings,
+    workers: int | None = None,
+    on_done: Callable[[dict], None] | None = None,
+) -> list[dict]:
+    """Run the jobs not already complete; returns every job's row, in input order."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for stale in out_dir.rglob(".*.partial*"):
+        stale.unlink(missing_ok=True)  # left by a killed run; never under a final name
+    previous = load_manifest(out_dir)
+    rows: dict[str, dict] = {}
+    todo = []
+    for job in jobs:
+        if is_complete(job, previous.get(job.input)):
+            rows[job.input] = {**previous[job.input], "status": "skipped", "seconds": 0.0}
+            if on_done:
+                on_done(rows[job.input])
+        else:
+            todo.append(job)
+    write_manifest(out_dir, {**previous, **rows})
+    for row in _execute(todo, settings, workers or default_workers()):
+        rows[row["input"]] = row
+        write_manifest(out_dir, {**previous, **rows})
+        if on_done:
+            on_done(row)
+    return [rows[job.input] for job in jobs]
+
+
+def _execute(jobs: list[Job], settings, workers: int) -> Iterator[dict]:
+    if workers <= 1 or len(jobs) <= 1:
+        for job in jobs:
+            yield run_job(job, settings)
+        return
+    threads = max(1, (os.cpu_count() or 1) // workers)
+    settings = replace(settings, encoding=replace(settings.encoding, threads=threads))
+    context = mp.get_context("spawn")  # clean workers: no inherited threads or locks
+    with ProcessPoolExecutor(
+        workers, mp_context=context, initializer=_limit_threads, initargs=(threads,)
+    ) as pool:
+        futures = [pool.submit(run_job, job, settings) for job in jobs]
+        for future in as_completed(futures):
+            yield future.result()
+
+
+__all__ = ["Job", "find_jobs", "load_manifest", "run_batch"]

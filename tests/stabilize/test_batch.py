@@ -1,0 +1,115 @@
+"""Folders: isolated failures, the manifest, resume, and a killed run."""
+
+import hashlib
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from stabilize.batch import find_jobs
+from stabilize.cli import app
+
+SAMPLE = Path(__file__).resolve().parents[2] / "samples" / "street" / "clip.mp4"
+
+
+def digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+@pytest.fixture
+def folder(tmp_path) -> Path:
+    src = tmp_path / "in"
+    (src / "day2").mkdir(parents=True)
+    (src / "a.mp4").write_bytes(SAMPLE.read_bytes())
+    (src / "day2" / "b.mp4").write_bytes(SAMPLE.read_bytes())
+    (src / "corrupt.mp4").write_bytes(SAMPLE.read_bytes()[:150_000])
+    (src / "notes.mov").write_text("not a video\n")
+    return src
+
+
+def test_a_folder_with_bad_files(folder, tmp_path):
+    before = {p: digest(p) for p in folder.rglob("*") if p.is_file()}
+    out = tmp_path / "out"
+    result = CliRunner().invoke(
+        app, ["batch", str(folder), str(out), "--recursive", "--workers", "2", "-q"]
+    )
+    assert result.exit_code == 1
+    assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*.mp4")) == [
+        "a.mp4",
+        "day2/b.mp4",
+    ]
+    rows = {r["input"]: r for r in json.loads((out / "manifest.json").read_text())}
+    assert [rows[k]["status"] for k in sorted(rows)] == ["done", "failed", "done", "failed"]
+    assert rows["corrupt.mp4"]["error"] and rows["notes.mov"]["error"]
+    assert (out / "manifest.csv").read_text().count("\n") == 5
+    assert {p: digest(p) for p in before} == before  # every input untouched
+
+    again = CliRunner().invoke(app, ["batch", str(folder), str(out), "--recursive", "-q"])
+    rows = {r["input"]: r for r in json.loads((out / "manifest.json").read_text())}
+    assert again.exit_code == 1
+    assert rows["a.mp4"]["status"] == rows["day2/b.mp4"]["status"] == "skipped"
+
+
+def test_a_changed_input_is_done_again(folder, tmp_path):
+    out = tmp_path / "out"
+    CliRunner().invoke(app, ["batch", str(folder), str(out), "--pattern", "a.mp4", "-q"])
+    os.utime(folder / "a.mp4", (time.time() + 10, time.time() + 10))
+    CliRunner().invoke(app, ["batch", str(folder), str(out), "--pattern", "a.mp4", "-q"])
+    rows = json.loads((out / "manifest.json").read_text())
+    assert rows[0]["status"] == "done"
+
+
+def test_gyro_sidecars_are_found_and_not_taken_for_clips(folder, tmp_path):
+    (folder / "a.gcsv").write_text("GYROFLOW IMU LOG\n")
+    jobs = {j.input: j for j in find_jobs(folder, tmp_path / "out", gyro_auto=True)}
+    assert jobs["a.mp4"].gyro.endswith("a.gcsv") and "a.gcsv" not in jobs
+
+
+def test_a_killed_run_leaves_nothing_unfinished_under_a_final_name(folder, tmp_path):
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "stabilize.cli",
+            "batch",
+            str(folder),
+            str(out),
+            "--recursive",
+            "--workers",
+            "1",
+            "-q",
+        ],
+        start_new_session=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    deadline = time.time() + 120
+    while time.time() < deadline and not list(out.rglob(".*.partial*")):
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    done = set()
+    if (out / "manifest.json").is_file():
+        done = {
+            r["output"]
+            for r in json.loads((out / "manifest.json").read_text())
+            if r["status"] in ("done", "skipped")
+        }
+    finals = {str(p) for p in out.rglob("*.mp4") if not p.name.startswith(".")}
+    assert finals <= done  # any file under a final name is one the manifest calls done
+    result = CliRunner().invoke(app, ["batch", str(folder), str(out), "--recursive", "-q"])
+    assert result.exit_code == 1  # resumes, and only the two bad files fail
+    assert not list(out.rglob(".*.partial*"))
+    assert len(list(out.rglob("*.mp4"))) == 2
+
+
+def test_batch_errors():
+    result = CliRunner().invoke(app, ["batch", "no-such-folder", "out"])
+    assert result.exit_code != 0 and "not a folder" in result.output
