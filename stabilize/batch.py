@@ -160,8 +160,13 @@ def run_batch(
     settings,
     workers: int | None = None,
     on_done: Callable[[dict], None] | None = None,
+    ray_address: str | None = None,
 ) -> list[dict]:
-    """Run the jobs not already complete; returns every job's row, in input order."""
+    """Run the jobs not already complete; returns every job's row, in input order.
+
+    With ``ray_address`` (an address, or ``auto`` for the running cluster) the jobs run
+    as Ray tasks instead of local processes; the manifest and resume work the same.
+    """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     for stale in out_dir.rglob(".*.partial*"):
@@ -177,7 +182,12 @@ def run_batch(
         else:
             todo.append(job)
     write_manifest(out_dir, {**previous, **rows})
-    for row in _execute(todo, settings, workers or default_workers()):
+    rows_in = (
+        _execute_ray(todo, settings, ray_address)
+        if ray_address
+        else _execute(todo, settings, workers or default_workers())
+    )
+    for row in rows_in:
         rows[row["input"]] = row
         write_manifest(out_dir, {**previous, **rows})
         if on_done:
@@ -199,6 +209,32 @@ def _execute(jobs: list[Job], settings, workers: int) -> Iterator[dict]:
         futures = [pool.submit(run_job, job, settings) for job in jobs]
         for future in as_completed(futures):
             yield future.result()
+
+
+def _execute_ray(jobs: list[Job], settings, address: str) -> Iterator[dict]:
+    """The jobs as Ray tasks, one CPU and one thread each; rows as tasks finish.
+
+    Every node must see the input and output paths (a shared file system) and have this
+    package installed.
+    """
+    try:
+        import ray
+    except ImportError:
+        raise RuntimeError(
+            "--ray needs the 'cluster' extra: pip install 'hough-stabilize[cluster]'"
+        ) from None
+    if not ray.is_initialized():
+        ray.init(address=address, log_to_driver=False)
+    single = {
+        v: "1"
+        for v in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")
+    }
+    task = ray.remote(num_cpus=1, runtime_env={"env_vars": single})(run_job)
+    settings = replace(settings, encoding=replace(settings.encoding, threads=1))
+    pending = [task.remote(job, settings) for job in jobs]
+    while pending:
+        ready, pending = ray.wait(pending, num_returns=1)
+        yield ray.get(ready[0])
 
 
 __all__ = ["Job", "find_jobs", "load_manifest", "run_batch"]

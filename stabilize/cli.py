@@ -466,7 +466,8 @@ def compare(
         "Examples:\n\n"
         "  stabilize batch trip/ trip-steady/\n\n"
         "  stabilize batch phone/ out/ --recursive --pattern '*.mp4' --workers 2\n\n"
-        "  stabilize batch clips/ out/ --gyro auto      # uses clip.gcsv / clip.csv beside clip.mp4"
+        "  stabilize batch clips/ out/ --gyro auto   # clip.gcsv or clip.csv beside clip.mp4\n\n"
+        "  stabilize batch /shared/in /shared/out --ray auto"
     )
 )
 def batch(
@@ -476,6 +477,9 @@ def batch(
     pattern: str = typer.Option("*", help="Which files, as a glob."),
     recursive: bool = typer.Option(False, help="Descend into subfolders."),
     gyro: str | None = typer.Option(None, help="'auto': use a gyro log with the same base name."),
+    ray: str | None = typer.Option(
+        None, help="Run on a Ray cluster: its address, or 'auto' (needs the 'cluster' extra)."
+    ),
     flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
     raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
     fov: float | None = typer.Option(None, help="Horizontal field of view, deg (default 69)."),
@@ -525,7 +529,10 @@ def batch(
             if not quiet:
                 console.print(f"{row['status']:8s} {row['input']}  {row.get('error', '')}")
 
-        rows = run_batch(jobs, out_dir, settings, workers, done)
+        try:
+            rows = run_batch(jobs, out_dir, settings, workers, done, ray_address=ray)
+        except (RuntimeError, ConnectionError) as err:
+            _fail(str(err).splitlines()[0])
     table = Table(title=f"{len(rows)} files → {out_dir}")
     for column in ("input", "status", "seconds", "zoom", "error"):
         table.add_column(column)
