@@ -27,7 +27,7 @@ import numpy as np
 
 from rotation import so3
 from stabilize.ffmpeg_tools import ffmpeg_exe
-from stabilize.metrics import evaluate
+from stabilize.metrics import evaluate_pair
 from stabilize.video_reader import probe, read_frames
 
 ENCODER = ["-c:v", "libx264", "-crf", "18", "-preset", "medium", "-pix_fmt", "yuv420p"]
@@ -130,11 +130,9 @@ def main() -> None:
         report = work / f"{clip.parent.name}_{clip.stem}_report"
         t_ours, m_ours = ours(clip, mine, report)
         t_vs, m_vs = vidstab(clip, theirs, work)
-        rows = {
-            "original": evaluate(read_frames(clip)),
-            "ours": evaluate(read_frames(clip), read_frames(mine, info.size)),
-            "vid.stab": evaluate(read_frames(clip), read_frames(theirs, info.size)),
-        }
+        original, ours_m = evaluate_pair(read_frames(clip), read_frames(mine, info.size))
+        _, theirs_m = evaluate_pair(read_frames(clip), read_frames(theirs, info.size))
+        rows = {"original": original, "ours": ours_m, "vid.stab": theirs_m}
         print(
             f"{'':10s}{'wall s':>8s}{'peak MB':>9s}{'crop':>7s}{'distort':>8s}"
             f"{'stab T':>8s}{'stab R':>8s}{'stab':>7s}{'ITF dB':>8s}"

@@ -25,6 +25,7 @@ from stabilize.ffmpeg_tools import atomic_output
 MANIFEST = "manifest.json"
 GYRO_SIDECARS = (".gcsv", ".csv", ".txt")
 BYTES_PER_WORKER = 1.5 * 2**30  # the pipeline's peak at 1080p, with headroom
+THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")
 
 
 @dataclass(frozen=True)
@@ -113,7 +114,7 @@ def is_complete(job: Job, row: dict | None) -> bool:
 
 def _limit_threads(threads: int) -> None:
     """Bound each worker's threads (numba, BLAS, OpenCV), so N workers share the cores."""
-    for var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    for var in THREAD_VARS:
         os.environ[var] = str(threads)
     import cv2
 
@@ -225,10 +226,7 @@ def _execute_ray(jobs: list[Job], settings, address: str) -> Iterator[dict]:
         ) from None
     if not ray.is_initialized():
         ray.init(address=address, log_to_driver=False)
-    single = {
-        v: "1"
-        for v in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")
-    }
+    single = dict.fromkeys(THREAD_VARS, "1")
     task = ray.remote(num_cpus=1, runtime_env={"env_vars": single})(run_job)
     settings = replace(settings, encoding=replace(settings.encoding, threads=1))
     pending = [task.remote(job, settings) for job in jobs]

@@ -157,7 +157,7 @@ def evaluate(
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON on stdout."),
 ) -> None:
     """Cropping ratio, distortion, stability and ITF of a stabilised clip and its original."""
-    from stabilize.metrics import evaluate as measure
+    from stabilize.metrics import evaluate_pair
     from stabilize.rotation_files import angular_errors, read_rotations
     from stabilize.video_reader import VideoError, probe, read_frames
 
@@ -166,8 +166,9 @@ def evaluate(
     try:
         info_o, info_s = probe(original), probe(stabilised)
         size = info_o.size
-        before = measure(read_frames(original, info=info_o))
-        after = measure(read_frames(original, info=info_o), read_frames(stabilised, size, info_s))
+        before, after = evaluate_pair(
+            read_frames(original, info=info_o), read_frames(stabilised, size, info_s)
+        )
         result = {"original": before.as_dict(), "stabilised": after.as_dict()}
         if truth is not None:
             err = angular_errors(read_rotations(rotations), read_rotations(truth))
@@ -412,7 +413,7 @@ def compare(
     """Compare the visual rotation estimate with a gyroscope log."""
     from stabilize import compare as cmp
     from stabilize.gyro import GyroError, read_gyro
-    from stabilize.gyro.readers import read_frame_timestamps_ns, read_frame_timestamps_s
+    from stabilize.gyro.readers import read_frame_timestamps_s
     from stabilize.gyro.sync import synchronise
     from stabilize.pipeline import estimate_rotations
     from stabilize.progress import progress_bar
@@ -424,12 +425,12 @@ def compare(
         log = read_gyro(gyro, gyro_format)
         args = sequence_args(video, start_number, fps)
         info = probe(video, args)
-        n = len(frame_times(video, args))
-        times = None
+        times = frame_times(video, args)
+        n = len(times)
         if timestamps is not None:
-            stamps = np.loadtxt(timestamps, ndmin=1)
-            reader = read_frame_timestamps_ns if stamps[0] > 1e12 else read_frame_timestamps_s
-            stamps = reader(timestamps)
+            stamps = read_frame_timestamps_s(timestamps)
+            if stamps[0] > 1e12:  # integer nanoseconds (OpenCamera), not seconds
+                stamps = stamps * 1e-9
             first = (start_number or 1) - 1 if args else 0  # line N is image N
             times = stamps[first : first + n]
             if len(times) < n:

@@ -21,9 +21,8 @@ from numpy.typing import NDArray
 
 from rotation import so3
 from stabilize.gyro import GyroLog, integrate_rotations
-from stabilize.gyro.sync import IntervalRates, Sync, visual_rates
+from stabilize.gyro.sync import MIN_CORRELATION, IntervalRates, Sync, visual_rates
 
-MIN_CORRELATION = 0.6  # of angular speeds, below which the log does not match the video
 MAX_ERROR_SHARE = 1.0  # AAE over the mean rotation per frame: the estimate says nothing
 
 

@@ -145,48 +145,65 @@ class ClipMetrics:
         return asdict(self)
 
 
-def evaluate(
-    original: Iterable[NDArray[np.uint8]],
-    stabilised: Iterable[NDArray[np.uint8]] | None = None,
-) -> ClipMetrics:
-    """Metrics of ``stabilised`` against ``original`` (or of ``original`` alone).
+class _Clip:
+    """One clip's running inter-frame registrations and PSNRs."""
+
+    def __init__(self) -> None:
+        self.reg = Registrar()
+        self.inter: list[NDArray] = []
+        self.itf: list[float] = []
+        self.previous: tuple | None = None  # (features, grey) of the last frame
+        self.frames = 0
+
+    def add(self, frame: NDArray[np.uint8]):
+        """Register a frame against the previous one; returns its features."""
+        feat = self.reg.features(frame)
+        grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
+        if self.previous is not None:
+            self.inter.append(self.reg.homography(self.previous[0], feat))
+            self.itf.append(psnr(self.previous[1], grey))
+        self.previous = (feat, grey)
+        self.frames += 1
+        return feat
+
+    def metrics(self, scales: list[float], ratios: list[float]) -> ClipMetrics:
+        st, sr = stability(self.inter)
+        return ClipMetrics(
+            frames=self.frames,
+            cropping_ratio=float(np.mean(scales)) if scales else 1.0,
+            distortion=float(np.min(ratios)) if ratios else 1.0,
+            stability_translation=st,
+            stability_rotation=sr,
+            stability=float(min(st, sr)),
+            itf_db=float(np.mean(self.itf)) if self.itf else float("nan"),
+            registration_failures=self.reg.failures,
+        )
+
+
+def evaluate_pair(
+    original: Iterable[NDArray[np.uint8]], stabilised: Iterable[NDArray[np.uint8]]
+) -> tuple[ClipMetrics, ClipMetrics]:
+    """Metrics of the original and of the stabilised clip, in one pass over both.
 
     Frames are taken in step; if one clip is longer, its extra frames are ignored.
-    For the original alone, cropping ratio and distortion are 1 by definition.
+    For the original, cropping ratio and distortion are 1 by definition.
     """
-    reg = Registrar()
-    scales, ratios, inter, itf = [], [], [], []
-    prev_feat = prev_frame = None
-    n = 0
-    pairs = (
-        ((o, None) for o in original)
-        if stabilised is None
-        else zip(original, stabilised, strict=False)
-    )
-    for orig, stab in pairs:
-        frame = orig if stab is None else stab
-        feat = reg.features(frame)
-        if stab is not None:
-            # Stabilised → original: a zoomed-in output registers with scale < 1.
-            H = reg.homography(feat, reg.features(orig))
-            center = ((frame.shape[1] - 1) / 2, (frame.shape[0] - 1) / 2)
-            scale, ratio = scale_and_distortion(H, center)
-            scales.append(scale)
-            ratios.append(ratio)
-        if prev_feat is not None:
-            inter.append(reg.homography(prev_feat, feat))
-            grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
-            itf.append(psnr(cv2.cvtColor(prev_frame, cv2.COLOR_RGB2GRAY), grey))
-        prev_feat, prev_frame = feat, frame
-        n += 1
-    st, sr = stability(inter)
-    return ClipMetrics(
-        frames=n,
-        cropping_ratio=float(np.mean(scales)) if scales else 1.0,
-        distortion=float(np.min(ratios)) if ratios else 1.0,
-        stability_translation=st,
-        stability_rotation=sr,
-        stability=float(min(st, sr)),
-        itf_db=float(np.mean(itf)) if itf else float("nan"),
-        registration_failures=reg.failures,
-    )
+    before, after = _Clip(), _Clip()
+    scales, ratios = [], []
+    for orig, stab in zip(original, stabilised, strict=False):
+        feat_orig, feat_stab = before.add(orig), after.add(stab)
+        # Stabilised → original: a zoomed-in output registers with scale < 1.
+        H = after.reg.homography(feat_stab, feat_orig)
+        center = ((stab.shape[1] - 1) / 2, (stab.shape[0] - 1) / 2)
+        scale, ratio = scale_and_distortion(H, center)
+        scales.append(scale)
+        ratios.append(ratio)
+    return before.metrics([], []), after.metrics(scales, ratios)
+
+
+def evaluate(frames: Iterable[NDArray[np.uint8]]) -> ClipMetrics:
+    """Metrics of one clip on its own (cropping ratio and distortion are 1)."""
+    clip = _Clip()
+    for frame in frames:
+        clip.add(frame)
+    return clip.metrics([], [])

@@ -96,19 +96,17 @@ def respect_zoom_budget(
     raw path needs none, so this ends). Returns (S, per-frame zoom).
     """
     amount = np.zeros(len(O))
-    zoom = zoom_of(S)
+    bent, zoom = S, zoom_of(S)
     sigma = max(smooth, 1e-3) / 2
     for _ in range(40):
         over = zoom > max_zoom
         if not over.any():
-            break
+            return bent, zoom
         amount = np.clip(amount + 0.25 * over, 0.0, 1.0)
         # Spread the pull over neighbouring frames (a Gaussian in time, peak kept).
         spread = np.array(
             [np.max(amount * np.exp(-0.5 * ((times - t) / sigma) ** 2)) for t in times]
         )
-        S_new = blend(S, O, spread)
-        zoom = zoom_of(S_new)
-    else:
-        S_new, zoom = O.copy(), zoom_of(O)
-    return (S_new if amount.any() else S), zoom
+        bent = blend(S, O, spread)
+        zoom = zoom_of(bent)
+    return O.copy(), zoom_of(O)

@@ -7,9 +7,7 @@ from scipy.signal import butter, filtfilt
 
 from stabilize.gyro.integrate import integrate_rotations
 from stabilize.gyro.log import GyroError, GyroLog
-from stabilize.gyro.sync import Sync, synchronise
-
-MIN_CORRELATION = 0.6
+from stabilize.gyro.sync import MIN_CORRELATION, Sync, synchronise
 
 
 def lowpass(log: GyroLog, cutoff_hz: float) -> GyroLog:

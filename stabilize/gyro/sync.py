@@ -26,6 +26,7 @@ from rotation import so3
 from stabilize.gyro.log import GyroError, GyroLog
 
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
+MIN_CORRELATION = 0.6  # of angular speeds, below which a log does not match the video
 MIN_COVERAGE = 0.8  # share of the frame pairs the log must cover (camera logs stop early)
 
 

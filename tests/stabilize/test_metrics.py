@@ -4,7 +4,7 @@ import pytest
 from typer.testing import CliRunner
 
 from stabilize.cli import app
-from stabilize.metrics import evaluate, low_frequency_share, scale_and_distortion
+from stabilize.metrics import evaluate, evaluate_pair, low_frequency_share, scale_and_distortion
 from stabilize.synth import SynthOptions, render_frames
 
 SMALL = {"size": (180, 320), "seconds": 3.0, "fps": 30.0, "crowd": 0, "seed": 3, "walk": 0}
@@ -34,8 +34,8 @@ def test_a_zoomed_crop_ranks_below_an_uncropped_one(shaken):
         M = cv2.getRotationMatrix2D(((w - 1) / 2, (h - 1) / 2), 0.0, z)
         return cv2.warpAffine(frame, M, (w, h), flags=cv2.INTER_LINEAR)
 
-    same = evaluate(shaken, shaken)
-    cropped = evaluate(shaken, [zoom(f, 1.25) for f in shaken])
+    _, same = evaluate_pair(shaken, shaken)
+    _, cropped = evaluate_pair(shaken, [zoom(f, 1.25) for f in shaken])
     assert same.cropping_ratio == pytest.approx(1.0, abs=0.01)
     assert cropped.cropping_ratio == pytest.approx(0.8, abs=0.02)
     assert cropped.distortion > 0.97
@@ -50,7 +50,7 @@ def test_metric_building_blocks():
 
 def test_registration_survives_featureless_frames():
     blank = [np.full((90, 160, 3), 128, np.uint8)] * 10
-    m = evaluate(blank, blank)
+    _, m = evaluate_pair(blank, blank)
     assert m.cropping_ratio == 1.0 and m.registration_failures > 0
 
 
