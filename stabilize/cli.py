@@ -261,6 +261,11 @@ def run(
     gyro_offset: float | None = typer.Option(None, help="Gyro minus video clock, s."),
     gyro_axes: str | None = typer.Option(None, help="IMU axis of camera x, y, z, e.g. YXz."),
     gyro_lpf: float | None = typer.Option(None, help="Low-pass the gyro at this many Hz."),
+    readout_ms: str | None = typer.Option(
+        None,
+        help="Rolling-shutter readout, ms, or 'auto' to estimate it (with --gyro). "
+        "Default: the log's own value, else none.",
+    ),
     overwrite: bool = typer.Option(False, help="Replace OUT if it exists."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar."),
     as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON on stdout."),
@@ -290,6 +295,7 @@ def run(
         gyro_offset=gyro_offset,
         gyro_axes=None if gyro_axes is None else tuple(map(tuple, _axes(gyro_axes))),
         gyro_lpf=gyro_lpf,
+        readout_ms=_readout(readout_ms, gyro),
     )
     with contextlib.ExitStack() as stack:
 
@@ -354,17 +360,29 @@ def rotations(
     try:
         info = probe(input_path)
         with progress_bar("estimating", None, quiet=quiet) as advance:
-            times, R, support = estimate_rotations(input_path, info, settings, advance)
+            track = estimate_rotations(input_path, info, settings, advance)
         if output is not None:
             with atomic_output(output, overwrite=overwrite) as tmp:
-                write_rotations(tmp, times[:-1], so3.log_so3(R), support)
+                write_rotations(tmp, track.times[:-1], so3.log_so3(track.rotations), track.support)
         if gcsv is not None:
             from stabilize.gyro.export import write_gcsv
 
             with atomic_output(gcsv, overwrite=overwrite) as tmp:
-                write_gcsv(tmp, times, R)
+                write_gcsv(tmp, track.times, track.rotations)
     except (VideoError, ValueError, FileExistsError, RuntimeError) as err:
         _fail(str(err))
+
+
+def _readout(value: str | None, gyro: object) -> float | str | None:
+    """--readout-ms: a number of ms or 'auto'; rolling-shutter correction needs the gyro."""
+    if value is not None and not gyro:
+        _fail("--readout-ms corrects the rolling shutter from the gyro: give --gyro LOG too")
+    if value is None or value == "auto":
+        return value
+    try:
+        return float(value)
+    except ValueError:
+        _fail(f"--readout-ms takes a number of milliseconds or 'auto', got {value!r}")
 
 
 def _axes(code: str | None):
@@ -404,6 +422,11 @@ def compare(
     offset: float | None = typer.Option(None, help="Gyro minus video clock, s (skip the search)."),
     axes: str | None = typer.Option(None, help="IMU axis of camera x, y, z, e.g. YXz."),
     search: float = typer.Option(1.0, min=0.0, help="Offset search range, ± seconds."),
+    readout_ms: str = typer.Option(
+        "auto",
+        help="Rolling-shutter readout, ms (0: global shutter), or 'auto': the log's value, "
+        "else estimated from bands of the frame.",
+    ),
     flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
     raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
     report: Path | None = typer.Option(None, help="Write pairs.csv, summary.json and plots here."),
@@ -415,7 +438,7 @@ def compare(
     from stabilize.gyro import GyroError, read_gyro
     from stabilize.gyro.readers import read_frame_timestamps_s
     from stabilize.gyro.sync import synchronise
-    from stabilize.pipeline import estimate_rotations
+    from stabilize.pipeline import READOUT_BANDS, estimate_rotations, readout_seconds
     from stabilize.progress import progress_bar
     from stabilize.video_reader import VideoError, frame_times, probe, sequence_args
 
@@ -435,12 +458,21 @@ def compare(
             times = stamps[first : first + n]
             if len(times) < n:
                 _fail(f"{timestamps}: {len(stamps)} frame times, the video needs {first + n}")
+        # Unlike the stabiliser, compare estimates (None) a readout the log does not give.
+        parsed = _readout(readout_ms, gyro)
+        readout = log.readout_s if parsed == "auto" else readout_seconds(parsed, None)
+        bands = READOUT_BANDS if readout is None else 0
         with progress_bar("estimating", n - 1, quiet=quiet) as advance:
-            times, R, _support = estimate_rotations(video, info, settings, advance, times)
+            track = estimate_rotations(video, info, settings, advance, times, bands=bands)
         sync = synchronise(
-            log, times, R, search=(-search, search), offset=offset, R_cam_imu=R_cam_imu
+            log,
+            track,
+            search=(-search, search),
+            offset=offset,
+            R_cam_imu=R_cam_imu,
+            readout=readout,
         )
-        result = cmp.compare(times, R, log, sync, settings.focal_px(info.width))
+        result = cmp.compare(track, log, sync, settings.focal_px(info.width))
     except (VideoError, GyroError, ValueError) as err:
         _fail(str(err))
     summary = result.summary()
@@ -451,11 +483,13 @@ def compare(
     if as_json:
         typer.echo(json.dumps(summary, indent=2))
         return
+    estimated = " (estimated)" if summary["readout_estimated"] else ""
     typer.echo(
         f"{summary['frames']} pairs: AAE {summary['aae_deg']:.4f}°, median "
         f"{summary['median_deg']:.4f}°, p95 {summary['p95_deg']:.4f}° (pitch "
         f"{summary['aae_pitch_deg']:.4f}°, yaw {summary['aae_yaw_deg']:.4f}°, roll "
-        f"{summary['aae_roll_deg']:.4f}°)\noffset {1000 * summary['offset_s']:+.2f} ms, gyro "
+        f"{summary['aae_roll_deg']:.4f}°)\noffset {1000 * summary['offset_s']:+.2f} ms, readout "
+        f"{summary['readout_ms']:.1f} ms{estimated}, gyro "
         f"{summary['gyro_rate_hz']:.1f} Hz, focal {summary['focal_px']:.1f} px, speed "
         f"correlation {summary['speed_correlation']:.3f}\nR_cam_imu = "
         f"{np.round(np.array(summary['R_cam_imu']), 4).tolist()}"

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import csv
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 from rotation import so3
 from stabilize.gyro import GyroLog, integrate_rotations
 from stabilize.gyro.sync import MIN_CORRELATION, IntervalRates, Sync, visual_rates
+from stabilize.track import VisualTrack
 
 MAX_ERROR_SHARE = 1.0  # AAE over the mean rotation per frame: the estimate says nothing
 
@@ -69,6 +70,8 @@ class Comparison:
         rms = np.sqrt(np.mean(self.rate_errors**2, axis=0))
         return {
             "offset_s": self.sync.offset,
+            "readout_ms": 1000.0 * self.sync.readout,
+            "readout_estimated": self.sync.readout_estimated,
             "aae_deg": float(err.mean()),
             "median_deg": float(np.median(err)),
             "p95_deg": float(np.percentile(err, 95)),
@@ -96,16 +99,19 @@ def axes_code(R: NDArray) -> str:
     return out
 
 
-def compare(times: NDArray, visual: NDArray, log: GyroLog, sync: Sync, focal: float) -> Comparison:
-    """Pairs inside the log's span are compared (camera logs often stop before the video)."""
-    times = np.asarray(times)
-    inside = IntervalRates(log).covered(times, sync.offset)
+def compare(track: VisualTrack, log: GyroLog, sync: Sync, focal: float) -> Comparison:
+    """Pairs inside the log's span are compared (camera logs often stop before the video).
+
+    Under a rolling shutter each pair's gyro interval is shifted to the capture time of
+    the rows its visual rotation was seen on (``sync.lag``).
+    """
+    inside = IntervalRates(log).covered(track.times, sync.offset, sync.lag(track))
     first, last = np.flatnonzero(inside)[[0, -1]]
-    times, visual = times[first : last + 2], visual[first : last + 1]
-    unbiased = GyroLog(log.times, log.rates - sync.bias, log.source)
-    gyro = integrate_rotations(unbiased, times, sync.offset, sync.R_cam_imu)
-    errors = so3.angular_error_deg(visual, gyro)
-    return Comparison(np.asarray(times), visual, gyro, errors, sync, focal, log.rate_hz)
+    track = track.pairs(first, last + 1)
+    unbiased = replace(log, rates=log.rates - sync.bias)
+    gyro = integrate_rotations(unbiased, track.times, sync.offset, sync.R_cam_imu, sync.lag(track))
+    errors = so3.angular_error_deg(track.rotations, gyro)
+    return Comparison(track.times, track.rotations, gyro, errors, sync, focal, log.rate_hz)
 
 
 def write_report(folder: str | Path, result: Comparison) -> None:

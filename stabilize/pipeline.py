@@ -24,19 +24,22 @@ import flow
 from rotation import HoughEstimator, so3
 from rotation.camera import focal_from_fov, intrinsics
 from stabilize.ffmpeg_tools import atomic_output
+from stabilize.rolling_shutter import RollingShutter
 from stabilize.smoothing import (
     orientations_from_rotations,
     respect_zoom_budget,
     smooth_orientations,
 )
+from stabilize.track import VisualTrack, mean_row
 from stabilize.video_reader import VideoError, VideoInfo, frame_times, probe, read_frames
 from stabilize.video_writer import Encoding, FrameWriter
-from stabilize.warping import homography, required_zoom, warp_frame
+from stabilize.warping import homography, required_zoom, warp_frame, warp_frame_rolling
 
 # A phone's main camera is about 26 mm full-frame equivalent: 69° across the long side.
 DEFAULT_HFOV = 69.0
 CROP_MODES = ("auto", "dynamic", "none")
 ESTIMATE_CHUNK = 32  # flow fields held at once in pass 1
+READOUT_BANDS = 6  # horizontal bands whose rotations date the rows (readout estimation)
 
 
 @dataclass(frozen=True)
@@ -56,6 +59,7 @@ class Settings:
     gyro_offset: float | None = None
     gyro_axes: tuple | None = None  # R_cam_imu as nested tuples
     gyro_lpf: float | None = None  # Hz
+    readout_ms: float | str | None = None  # rolling shutter: ms, 'auto', or the log's value
     encoding: Encoding = field(default_factory=Encoding)
 
     def focal_px(self, width: int) -> float:
@@ -74,8 +78,11 @@ class CameraPath:
     raw: NDArray  # (N, 3, 3) O_t
     smooth: NDArray  # (N, 3, 3) S_t
     zoom: NDArray  # (N,) applied zoom
-    homographies: NDArray  # (N, 3, 3) input → output pixels
+    homographies: NDArray  # (N, 3, 3) input → output pixels (the middle row's)
     K: NDArray
+    # Rolling shutter: the homographies of each knot row (N, B, 3, 3) at input rows (B,).
+    row_homographies: NDArray | None = None
+    knot_rows: NDArray | None = None
 
 
 Progress = Callable[[int], None]
@@ -91,10 +98,14 @@ def estimate_rotations(
     settings: Settings,
     progress: Progress = _no_progress,
     times: NDArray | None = None,
-) -> tuple[NDArray, NDArray, NDArray]:
-    """Pass 1: (times, R_t, support) for the clip; frames streamed at the working size.
+    *,
+    bands: int = 0,
+) -> VisualTrack:
+    """Pass 1: the clip's rotations, frames streamed at the working size.
 
     Frame times are the container's timestamps unless given (e.g. from a sensor log).
+    ``bands`` > 0 also estimates each pair's rotation from that many horizontal bands of
+    the frame alone (for the rolling-shutter readout; about 0.5 ms per band and pair).
     """
     times = frame_times(path, info.input_args) if times is None else np.asarray(times)
     if len(times) < 2:
@@ -102,13 +113,22 @@ def estimate_rotations(
     ws = flow.working_size(info.size)
     focal = settings.focal_px(info.width) * ws.scale[0]
     estimator = HoughEstimator(ws.size, focal, max_deg=settings.max_deg)
+    sample_rows = estimator.grid.rows
     backend = flow.get(settings.flow, **settings.flow_options)
-    rotations, support, chunk = [], [], []
+    height = ws.size[0]
+    edges = np.linspace(0, height, bands + 1).round().astype(int)
+    found: list[list[tuple]] = [[] for _ in range(bands + 1)]  # whole frame, then bands
+    chunk: list[NDArray] = []
 
     def flush() -> None:
-        for est in estimator.estimate_many(np.stack(chunk)):
-            rotations.append(est.matrix)
-            support.append(est.support)
+        flows = np.stack(chunk)
+        for b in range(bands + 1):
+            if b:  # only this band's vectors vote
+                flows = np.stack(chunk)
+                flows[:, : edges[b - 1]] = np.nan
+                flows[:, edges[b] :] = np.nan
+            for est in estimator.estimate_many(flows):
+                found[b].append((est.matrix, est.support, mean_row(est, sample_rows, height)))
         progress(len(chunk))
         chunk.clear()
 
@@ -118,7 +138,7 @@ def estimate_rotations(
             flush()
     if chunk:
         flush()
-    n = len(rotations) + 1
+    n = len(found[0]) + 1
     if n < 2:
         raise VideoError(f"{path}: fewer than two frames decoded; nothing to stabilise")
     if n < len(times) - 1:
@@ -128,7 +148,14 @@ def estimate_rotations(
         )
     if len(times) != n:  # a frame's worth of slack for containers that list one extra
         times = times[:n] if len(times) > n else np.arange(n) / max(info.fps, 1.0)
-    return times, np.array(rotations), np.array(support)
+    R, support, rows = (np.array([item[i] for item in found[0]]) for i in range(3))
+    if not bands:
+        return VisualTrack(times, R, support, rows)
+    R_b, support_b, rows_b = (
+        np.stack([np.array([item[i] for item in found[b]]) for b in range(1, bands + 1)])
+        for i in range(3)
+    )
+    return VisualTrack(times, R, support, rows, R_b, rows_b, support_b)
 
 
 MIN_SUPPORT = 0.03  # below this share of agreeing vectors a frame's rotation is a guess
@@ -166,16 +193,27 @@ def plan(
     K: NDArray,
     size: tuple[int, int],
     settings: Settings,
+    rolling: RollingShutter | None = None,
 ) -> CameraPath:
-    """Smooth the path, keep it within the zoom budget, and choose each frame's zoom."""
+    """Smooth the path, keep it within the zoom budget, and choose each frame's zoom.
+
+    With ``rolling``, each frame's correction also undoes the camera's turn between its
+    middle row and every other row, C_t(y) = C_t D_t(y)ᵀ.
+    """
     if settings.crop not in CROP_MODES:
         raise ValueError(f"crop must be one of {CROP_MODES}, got {settings.crop!r}")
     O = orientations_from_rotations(rotations)
     S = smooth_orientations(O, times, settings.smooth, settings.method)
+    rows = None if rolling is None else rolling.rows
+
+    def corrections(path: NDArray) -> NDArray:
+        C = path @ np.swapaxes(O, -1, -2)
+        return C if rolling is None else C[:, None] @ np.swapaxes(rolling.turns, -1, -2)
 
     def zoom_of(path: NDArray) -> NDArray:
-        C = path @ np.swapaxes(O, -1, -2)
-        return np.array([required_zoom(K, c, size, settings.max_zoom * 1.001) for c in C])
+        return np.array(
+            [required_zoom(K, c, size, settings.max_zoom * 1.001, rows) for c in corrections(path)]
+        )
 
     if settings.crop == "none":
         need = np.ones(len(O))
@@ -184,7 +222,12 @@ def plan(
     zoom = choose_zoom(need, times, settings)
     C = S @ np.swapaxes(O, -1, -2)
     H = np.array([homography(K, c, z) for c, z in zip(C, zoom, strict=True)])
-    return CameraPath(times, rotations, support, O, S, zoom, H, K)
+    if rolling is None:
+        return CameraPath(times, rotations, support, O, S, zoom, H, K)
+    H_rows = np.array(
+        [homography(K, c, z) for cs, z in zip(corrections(S), zoom, strict=True) for c in cs]
+    ).reshape(len(O), len(rows), 3, 3)
+    return CameraPath(times, rotations, support, O, S, zoom, H, K, H_rows, rows)
 
 
 def choose_zoom(need: NDArray, times: NDArray, settings: Settings) -> NDArray:
@@ -216,31 +259,64 @@ def render(
     h, w = info.size
     size = (h, 2 * w) if settings.preview else (h, w)
     with FrameWriter(out, size, fps, settings.encoding, audio, copy_audio=True) as writer:
-        for frame, H in zip(read_frames(path, info=info), planned.homographies, strict=False):
-            warped = warp_frame(frame, H)
+        for k, frame in zip(range(len(planned.zoom)), read_frames(path, info=info), strict=False):
+            if planned.row_homographies is None:
+                warped = warp_frame(frame, planned.homographies[k])
+            else:
+                warped = warp_frame_rolling(frame, planned.row_homographies[k], planned.knot_rows)
             writer.write(np.hstack([frame, warped]) if settings.preview else warped)
             written += 1
             progress(1)
     return written
 
 
-def _from_gyro(settings: Settings, times: NDArray, R_visual: NDArray) -> tuple[NDArray, dict]:
-    """R_t from the gyro log named in settings, synchronised against the visual estimate."""
+def _from_gyro(
+    settings: Settings, track: VisualTrack, height: int
+) -> tuple[NDArray, RollingShutter | None, dict]:
+    """R_t from the gyro log named in settings, synchronised against the visual estimate,
+    and the per-row turns when the readout time is known (or estimated)."""
     from stabilize.gyro import read_gyro
     from stabilize.gyro.source import gyro_rotations, lowpass
+    from stabilize.rolling_shutter import frame_rotations, row_turns
 
     log = read_gyro(settings.gyro, settings.gyro_format)
     if settings.gyro_lpf:
         log = lowpass(log, settings.gyro_lpf)
     axes = None if settings.gyro_axes is None else np.array(settings.gyro_axes, dtype=float)
-    R, sync = gyro_rotations(log, times, R_visual, offset=settings.gyro_offset, R_cam_imu=axes)
-    return R, {
-        "log": str(settings.gyro),
-        "offset_s": sync.offset,
-        "R_cam_imu": sync.R_cam_imu.tolist(),
-        "speed_correlation": sync.correlation,
-        "rate_hz": log.rate_hz,
-    }
+    readout = readout_seconds(settings.readout_ms, log.readout_s)
+    att, sync = gyro_rotations(
+        log, track, offset=settings.gyro_offset, R_cam_imu=axes, readout=readout
+    )
+    R = frame_rotations(att, track.times, sync.offset, sync.readout)
+    rolling = (
+        row_turns(att, track.times, sync.offset, sync.readout, height) if sync.readout else None
+    )
+    return (
+        R,
+        rolling,
+        {
+            "log": str(settings.gyro),
+            "offset_s": sync.offset,
+            "R_cam_imu": sync.R_cam_imu.tolist(),
+            "speed_correlation": sync.correlation,
+            "rate_hz": log.rate_hz,
+            "readout_ms": 1000.0 * sync.readout,
+            "readout_estimated": sync.readout_estimated,
+        },
+    )
+
+
+def readout_seconds(option: float | str | None, from_log: float | None) -> float | None:
+    """The readout to use: ``--readout-ms`` (a number, or 'auto': estimate it), else the
+    log's own value, else 0 (no rolling-shutter correction). None means 'estimate'."""
+    if option is None:
+        return from_log or 0.0
+    if option == "auto":
+        return None
+    value = float(option)
+    if not 0.0 <= value < 1000.0:
+        raise ValueError(f"--readout-ms must be between 0 and 1000 ms, got {option}")
+    return value / 1000.0
 
 
 def stabilize_video(
@@ -262,15 +338,17 @@ def stabilize_video(
     info = probe(src)
     start = time.perf_counter()
     bar = progress or (lambda label, total: _no_progress)
-    times, R, support = estimate_rotations(src, info, settings, bar("estimating", None))
-    gyro_summary = None
+    bands = READOUT_BANDS if settings.gyro and settings.readout_ms == "auto" else 0
+    track = estimate_rotations(src, info, settings, bar("estimating", None), bands=bands)
+    times, support = track.times, track.support
+    gyro_summary, rolling = None, None
     if settings.gyro:
-        R, gyro_summary = _from_gyro(settings, times, R)
+        R, rolling, gyro_summary = _from_gyro(settings, track, info.height)
     else:
-        R, reliable = repair_unreliable(R, support)
+        R, reliable = repair_unreliable(track.rotations, support)
     t_estimate = time.perf_counter() - start
     K = intrinsics(settings.focal_px(info.width), info.size)
-    planned = plan(times, R, support, K, info.size, settings)
+    planned = plan(times, R, support, K, info.size, settings, rolling)
     t_plan = time.perf_counter() - start - t_estimate
     with atomic_output(dst, overwrite=overwrite) as tmp:
         frames = render(src, tmp, info, planned, settings, bar("stabilising", len(times)))

@@ -7,15 +7,25 @@ rays into the smoothed camera's. Output pixels are then
 
 (about the principal point). A zoom z hides the borders of frame t when every output
 border pixel maps back inside the input frame.
+
+Under a rolling shutter each input row y was captured at its own time, so the correction
+depends on the row: C_t(y) = C_t D(y)ᵀ, with D(y) the camera's turn between the frame's
+middle row and row y. A frame's warp is then a stack of homographies H(y_b) at knot rows
+y_b, interpolated in between. An output pixel's source row is itself unknown, so it is
+found by a fixed-point iteration: y ← row of H(y)⁻¹ p_out, starting from the middle.
 """
 
 from __future__ import annotations
+
+import functools
 
 import cv2
 import numpy as np
 from numpy.typing import NDArray
 
 BORDER_SAMPLES = 16  # points per edge checked for coverage
+ROW_ITERATIONS = 2  # fixed-point steps for an output pixel's source row
+MAP_STEP = 8  # output pixels between exactly computed points of a rolling-shutter map
 
 
 def zoomed(K: NDArray, zoom: float) -> NDArray:
@@ -26,9 +36,9 @@ def zoomed(K: NDArray, zoom: float) -> NDArray:
 
 
 def homography(K: NDArray, C: NDArray, zoom: float = 1.0) -> NDArray[np.float64]:
-    """Input pixels → output pixels: K' C K⁻¹."""
+    """Input pixels → output pixels: K' C K⁻¹ (for one C, or a stack of them)."""
     H = zoomed(K, zoom) @ C @ np.linalg.inv(K)
-    return H / H[2, 2]
+    return H / H[..., 2:, 2:]
 
 
 def _border(size: tuple[int, int]) -> NDArray:
@@ -45,27 +55,62 @@ def _border(size: tuple[int, int]) -> NDArray:
     )
 
 
-def covers(K: NDArray, C: NDArray, zoom: float, size: tuple[int, int]) -> bool:
-    """Whether the output frame at ``zoom`` lies entirely inside the warped input."""
+def back_project(Hinv: NDArray, rows: NDArray | None, pts: NDArray) -> NDArray[np.float64]:
+    """Input pixels (M, 3) homogeneous of output pixels ``pts`` (M, 2).
+
+    ``Hinv`` is one inverse homography (3, 3), or one per knot row (B, 3, 3) with the
+    input rows ``rows`` (B,) they hold at (rolling shutter).
+    """
+    ph = np.c_[pts, np.ones(len(pts))]
+    if rows is None:
+        return ph @ Hinv.T
+    out = ph @ Hinv[len(rows) // 2].T
+    for _ in range(ROW_ITERATIONS):
+        y = np.clip(out[:, 1] / np.where(out[:, 2] > 0, out[:, 2], 1.0), rows[0], rows[-1])
+        k = np.clip(np.searchsorted(rows, y) - 1, 0, len(rows) - 2)
+        frac = ((y - rows[k]) / (rows[k + 1] - rows[k]))[:, None, None]
+        H = Hinv[k] + frac * (Hinv[k + 1] - Hinv[k])
+        out = np.einsum("mij,mj->mi", H, ph)
+    return out
+
+
+def inverses(H: NDArray) -> NDArray[np.float64]:
+    """Inverse homographies, scaled to H[2, 2] = 1 so that they interpolate."""
+    Hinv = np.linalg.inv(H)
+    return Hinv / Hinv[..., 2:, 2:]
+
+
+def covers(
+    K: NDArray, C: NDArray, zoom: float, size: tuple[int, int], rows: NDArray | None = None
+) -> bool:
+    """Whether the output frame at ``zoom`` lies entirely inside the warped input.
+
+    ``C`` is one correction, or one per knot row in ``rows`` (rolling shutter).
+    """
     h, w = size
-    Hinv = np.linalg.inv(homography(K, C, zoom))
-    pts = np.c_[_border(size), np.ones(4 * BORDER_SAMPLES)] @ Hinv.T
+    pts = back_project(inverses(homography(K, C, zoom)), rows, _border(size))
     if np.any(pts[:, 2] <= 0):
         return False
     x, y = pts[:, 0] / pts[:, 2], pts[:, 1] / pts[:, 2]
     return bool(np.all((x >= -0.5) & (x <= w - 0.5) & (y >= -0.5) & (y <= h - 0.5)))
 
 
-def required_zoom(K: NDArray, C: NDArray, size: tuple[int, int], max_zoom: float = 4.0) -> float:
+def required_zoom(
+    K: NDArray,
+    C: NDArray,
+    size: tuple[int, int],
+    max_zoom: float = 4.0,
+    rows: NDArray | None = None,
+) -> float:
     """The smallest zoom ≥ 1 with no border in frame (bisection); inf if above max_zoom."""
-    if covers(K, C, 1.0, size):
+    if covers(K, C, 1.0, size, rows):
         return 1.0
-    if not covers(K, C, max_zoom, size):
+    if not covers(K, C, max_zoom, size, rows):
         return np.inf
     lo, hi = 1.0, max_zoom
     for _ in range(30):
         mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if covers(K, C, mid, size) else (mid, hi)
+        lo, hi = (lo, mid) if covers(K, C, mid, size, rows) else (mid, hi)
     return hi
 
 
@@ -75,3 +120,37 @@ def warp_frame(frame: NDArray[np.uint8], H: NDArray) -> NDArray[np.uint8]:
     return cv2.warpPerspective(
         frame, H, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT
     )
+
+
+def warp_frame_rolling(frame: NDArray[np.uint8], H: NDArray, rows: NDArray) -> NDArray[np.uint8]:
+    """Warp by row-dependent homographies H (B, 3, 3) at input knot rows (B,).
+
+    The source coordinates are computed exactly on a grid every ``MAP_STEP`` output
+    pixels, corners included, and interpolated bilinearly in between (the map is smooth:
+    about 0.01 px off), then ``cv2.remap`` samples the frame.
+    """
+    h, w = frame.shape[:2]
+    (xs, Wx), (ys, Wy) = _knots(w), _knots(h)
+    gx, gy = np.meshgrid(xs, ys)
+    src = back_project(inverses(H), rows, np.c_[gx.ravel(), gy.ravel()])
+    z = np.where(src[:, 2] > 1e-9, src[:, 2], np.nan)
+    coarse = np.nan_to_num(src[:, :2] / z[:, None], nan=-1e4).reshape(*gx.shape, 2)
+    # Bilinear upsampling as two small matrix products, in float: cv2.resize cannot keep
+    # the corners aligned and cv2.remap would quantise the weights to 1/32 of a cell.
+    maps = [Wy @ coarse[..., c].astype(np.float32) @ Wx.T for c in range(2)]
+    return cv2.remap(frame, maps[0], maps[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
+
+
+@functools.lru_cache(maxsize=8)
+def _knots(n: int) -> tuple[NDArray, NDArray]:
+    """Knot positions every ~MAP_STEP pixels over 0..n-1 (both ends included), and the
+    (n, knots) matrix of linear-interpolation weights from knots to pixels."""
+    count = (n - 1) // MAP_STEP + 2
+    knots = np.linspace(0.0, n - 1.0, count)
+    u = np.arange(n) * ((count - 1) / max(n - 1, 1))
+    before = np.minimum(u.astype(np.intp), count - 2)
+    frac = u - before
+    weights = np.zeros((n, count), np.float32)
+    weights[np.arange(n), before] = 1.0 - frac
+    weights[np.arange(n), before + 1] = frac
+    return knots, weights

@@ -1,17 +1,25 @@
-"""Integrating gyro rates into frame-to-frame rotations (CONVENTIONS.md).
+"""Integrating gyro rates into camera attitude and frame-to-frame rotations (CONVENTIONS.md).
 
 A gyro sample at gyro time g belongs to video time g - offset. In camera axes the rate
-is ω_cam = R_cam_imu ω_imu, and over the interval between two frame times
+is ω_cam = R_cam_imu ω_imu. The attitude G(τ) is the rotation accumulated since the start
+of the log, later factors on the left, so that the rotation between two times is
 
-    R_t = Π exp(-[ω_cam(τ) dτ]×)      (later factors on the left),
+    R(a → b) = G(b) G(a)ᵀ,        G(t_{i+1}) = exp(-[φ_i]×) G(t_i),
 
-the minus because static directions turn opposite to the body. Rates are interpolated
-linearly between samples and integrated with the midpoint rule over every piece
-between consecutive sample and frame times, so the ends are interpolated exactly.
+the minus because static directions turn opposite to the body. Rates are linear between
+samples, so over the part s of a sample interval Δ the angle is integrated exactly:
+
+    φ(s) = ω_i s + (ω_{i+1} - ω_i) s² / (2Δ).
+
+An attitude can be asked for at any time, which is what rolling-shutter correction needs:
+each row of a frame has its own capture time.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+import numba
 import numpy as np
 from numpy.typing import NDArray
 
@@ -19,11 +27,55 @@ from rotation import so3
 from stabilize.gyro.log import GyroError, GyroLog
 
 
-def rates_at(log: GyroLog, t_video: NDArray, offset: float, R_cam_imu: NDArray) -> NDArray:
-    """ω_cam (len(t), 3) at video times, linearly interpolated."""
-    g = np.asarray(t_video) + offset
-    imu = np.stack([np.interp(g, log.times, log.rates[:, a]) for a in range(3)], axis=-1)
-    return imu @ np.asarray(R_cam_imu).T
+@numba.njit(cache=True)
+def _chain(steps: NDArray) -> NDArray:
+    """G_0 = I, G_{i+1} = steps_i G_i."""
+    out = np.empty((len(steps) + 1, 3, 3))
+    out[0] = np.eye(3)
+    for i in range(len(steps)):
+        out[i + 1] = steps[i] @ out[i]
+    return out
+
+
+@dataclass(frozen=True)
+class Attitude:
+    """G at every gyro sample (gyro clock), with the camera-axis rates it came from."""
+
+    times: NDArray[np.float64]  # (M,) gyro clock
+    rates: NDArray[np.float64]  # (M, 3) ω_cam
+    G: NDArray[np.float64]  # (M, 3, 3)
+    source: str = ""
+
+    def at(self, t: NDArray) -> NDArray[np.float64]:
+        """G at gyro-clock times ``t`` (any shape ...), (..., 3, 3)."""
+        t = np.asarray(t, dtype=np.float64)
+        flat = t.ravel()
+        i = np.clip(np.searchsorted(self.times, flat, side="right") - 1, 0, len(self.times) - 2)
+        delta = self.times[i + 1] - self.times[i]
+        s = (flat - self.times[i])[:, None]
+        w0, w1 = self.rates[i], self.rates[i + 1]
+        phi = w0 * s + (w1 - w0) * s**2 / (2.0 * delta[:, None])
+        return (so3.exp_so3(-phi) @ self.G[i]).reshape(*t.shape, 3, 3)
+
+    def between(self, a: NDArray, b: NDArray) -> NDArray[np.float64]:
+        """R(a → b) = G(b) G(a)ᵀ for gyro-clock times."""
+        return self.at(b) @ np.swapaxes(self.at(a), -1, -2)
+
+    def check_covers(self, lo: float, hi: float, offset: float) -> None:
+        first, last = self.times[0], self.times[-1]
+        if lo < first - 1e-9 or hi > last + 1e-9:
+            raise GyroError(
+                f"{self.source}: the gyro log covers {first - offset:.3f}–{last - offset:.3f} s "
+                f"of video time, the frames {lo - offset:.3f}–{hi - offset:.3f} s"
+            )
+
+
+def attitude(log: GyroLog, R_cam_imu: NDArray | None = None) -> Attitude:
+    """The camera's attitude over the whole log."""
+    R_cam_imu = np.eye(3) if R_cam_imu is None else np.asarray(R_cam_imu, dtype=np.float64)
+    rates = log.rates @ R_cam_imu.T
+    phi = 0.5 * (rates[1:] + rates[:-1]) * np.diff(log.times)[:, None]
+    return Attitude(log.times, rates, _chain(so3.exp_so3(-phi)), log.source)
 
 
 def integrate_rotations(
@@ -31,23 +83,16 @@ def integrate_rotations(
     frame_times: NDArray,
     offset: float = 0.0,
     R_cam_imu: NDArray | None = None,
+    lag: NDArray | float = 0.0,
 ) -> NDArray[np.float64]:
-    """R_t for each pair of consecutive frame times (video clock), (N-1, 3, 3)."""
+    """R_t for each pair of consecutive frame times (video clock), (N-1, 3, 3).
+
+    ``lag`` (per pair, s) shifts both ends of each interval: under a rolling shutter, the
+    capture time of the rows a rotation was measured on (readout × their mean height).
+    """
     frame_times = np.asarray(frame_times, dtype=np.float64)
-    R_cam_imu = np.eye(3) if R_cam_imu is None else np.asarray(R_cam_imu, dtype=np.float64)
-    first, last = log.span
-    if frame_times[0] + offset < first or frame_times[-1] + offset > last:
-        raise GyroError(
-            f"{log.source}: the gyro log covers {first - offset:.3f}–{last - offset:.3f} s of "
-            f"video time, the frames {frame_times[0]:.3f}–{frame_times[-1]:.3f} s"
-        )
-    inside = (log.times - offset > frame_times[0]) & (log.times - offset < frame_times[-1])
-    knots = np.union1d(frame_times, log.times[inside] - offset)
-    mids = 0.5 * (knots[1:] + knots[:-1])
-    steps = so3.exp_so3(-rates_at(log, mids, offset, R_cam_imu) * np.diff(knots)[:, None])
-    # Which frame interval each piece belongs to.
-    owner = np.searchsorted(frame_times, mids, side="right") - 1
-    out = np.tile(np.eye(3), (len(frame_times) - 1, 1, 1))
-    for k, E in zip(owner, steps, strict=True):
-        out[k] = E @ out[k]
-    return out
+    a = frame_times[:-1] + lag + offset
+    b = frame_times[1:] + lag + offset
+    att = attitude(log, R_cam_imu)
+    att.check_covers(float(np.min(a)), float(np.max(b)), offset)
+    return att.between(a, b)

@@ -15,11 +15,13 @@ class GyroError(ValueError):
 @dataclass(frozen=True)
 class GyroLog:
     """times (N,) in seconds on the gyro clock, strictly increasing; rates (N, 3) in
-    rad/s, in the sensor's axes."""
+    rad/s, in the sensor's axes; the camera's rolling-shutter readout (s) when the log
+    records it."""
 
     times: NDArray[np.float64]
     rates: NDArray[np.float64]
     source: str = ""
+    readout_s: float | None = None
 
     def __post_init__(self) -> None:
         if self.rates.shape != (len(self.times), 3):

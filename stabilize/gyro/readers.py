@@ -84,7 +84,8 @@ def _frame_times(path: Path, scale: float) -> np.ndarray:
 
 
 def read_gcsv(path: str | Path) -> GyroLog:
-    """Gyroflow .gcsv: header fields, ``tscale`` and ``gscale``, and ``orientation``.
+    """Gyroflow .gcsv: header fields, ``tscale`` and ``gscale``, ``orientation``, and
+    ``frame_readout_time`` (ms, top to bottom) when present.
 
     ``orientation`` (e.g. ``YxZ``) says which sensor axis each logged column is, a
     lower-case letter meaning the negative axis; rates are returned in sensor axes.
@@ -119,7 +120,14 @@ def read_gcsv(path: str | Path) -> GyroLog:
     data = np.array(_rows(path, len(columns), start=start))[:, idx]
     rates = data[:, 1:] * gscale
     rates = rates @ orientation_matrix(header.get("orientation", "XYZ"), path).T
-    return GyroLog(data[:, 0] * tscale, rates, str(path))
+    readout = header.get("frame_readout_time")
+    try:
+        readout_s = float(readout) / 1000.0 if readout else None  # logged in ms
+    except ValueError:
+        raise GyroError(f"{path}: frame_readout_time must be a number of ms") from None
+    if readout_s is not None and header.get("frame_readout_direction", "0") not in ("0", ""):
+        readout_s = None  # only top-to-bottom readout is modelled
+    return GyroLog(data[:, 0] * tscale, rates, str(path), readout_s)
 
 
 def orientation_matrix(code: str, path: Path | str = "") -> np.ndarray:

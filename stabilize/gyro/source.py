@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from numpy.typing import NDArray
 from scipy.signal import butter, filtfilt
 
-from stabilize.gyro.integrate import integrate_rotations
+from stabilize.gyro.integrate import Attitude, attitude
 from stabilize.gyro.log import GyroError, GyroLog
 from stabilize.gyro.sync import MIN_CORRELATION, Sync, synchronise
+from stabilize.track import VisualTrack
 
 
 def lowpass(log: GyroLog, cutoff_hz: float) -> GyroLog:
@@ -16,30 +19,36 @@ def lowpass(log: GyroLog, cutoff_hz: float) -> GyroLog:
     if not 0 < cutoff_hz < nyquist:
         raise GyroError(f"--gyro-lpf must be between 0 and {nyquist:.0f} Hz, got {cutoff_hz}")
     b, a = butter(2, cutoff_hz, fs=log.rate_hz)
-    return GyroLog(log.times, filtfilt(b, a, log.rates, axis=0), log.source)
+    return replace(log, rates=filtfilt(b, a, log.rates, axis=0))
 
 
 def gyro_rotations(
     log: GyroLog,
-    times: NDArray,
-    R_visual: NDArray,
+    track: VisualTrack,
     *,
     offset: float | None = None,
     R_cam_imu: NDArray | None = None,
+    readout: float | None = 0.0,
     search: float = 1.0,
-) -> tuple[NDArray, Sync]:
-    """R_t from the gyro, synchronised against the visual estimate, bias removed.
+) -> tuple[Attitude, Sync]:
+    """The camera attitude from the gyro, synchronised against the visual estimate, bias
+    removed, in camera axes on the gyro clock (video time + ``sync.offset``).
 
     Refuses a log whose motion does not match the video's: stabilising from it would
     shake the clip instead.
     """
     sync = synchronise(
-        log, times, R_visual, search=(-search, search), offset=offset, R_cam_imu=R_cam_imu
+        log,
+        track,
+        search=(-search, search),
+        offset=offset,
+        R_cam_imu=R_cam_imu,
+        readout=readout,
     )
     if sync.correlation < MIN_CORRELATION:
         raise GyroError(
             f"{log.source}: the gyro's motion does not match the video's (speed correlation "
             f"{sync.correlation:.2f}); check the log, or give --gyro-offset and --gyro-axes"
         )
-    unbiased = GyroLog(log.times, log.rates - sync.bias, log.source)
-    return integrate_rotations(unbiased, times, sync.offset, sync.R_cam_imu), sync
+    unbiased = replace(log, rates=log.rates - sync.bias)
+    return attitude(unbiased, sync.R_cam_imu), sync

@@ -18,24 +18,33 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from numpy.typing import NDArray
 
 from rotation import so3
 from stabilize.gyro.log import GyroError, GyroLog
+from stabilize.track import VisualTrack
 
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 MIN_CORRELATION = 0.6  # of angular speeds, below which a log does not match the video
 MIN_COVERAGE = 0.8  # share of the frame pairs the log must cover (camera logs stop early)
+MIN_BAND_SUPPORT = 0.05  # a band with so few agreeing vectors says little about its time
 
 
 @dataclass(frozen=True)
 class Sync:
-    offset: float  # s, gyro clock minus video clock
+    offset: float  # s, gyro clock minus video clock, at the first row of each frame
     R_cam_imu: NDArray[np.float64]
     bias: NDArray[np.float64]  # rad/s, in IMU axes
     correlation: float  # of the angular speeds at the offset
+    readout: float = 0.0  # s, rolling-shutter readout (first to last row); 0: global
+    readout_estimated: bool = False
+
+    def lag(self, track: VisualTrack) -> NDArray[np.float64]:
+        """Per pair, when its rotation was seen after the first row: readout × mean height."""
+        return self.readout * track.rows
 
 
 def signed_permutations() -> list[NDArray[np.float64]]:
@@ -63,40 +72,46 @@ class IntervalRates:
         steps = np.diff(log.times)[:, None] * 0.5 * (log.rates[1:] + log.rates[:-1])
         self.integral = np.vstack([np.zeros(3), np.cumsum(steps, axis=0)])
 
-    def __call__(self, times: NDArray, offset: float) -> NDArray[np.float64]:
-        """(N-1, 3) mean ω_imu over [t_k, t_{k+1}] shifted onto the gyro clock; NaN rows
-        for intervals the log does not cover."""
-        g = np.asarray(times) + offset
-        I = np.stack([np.interp(g, self.log.times, self.integral[:, a]) for a in range(3)], -1)
-        rates = np.diff(I, axis=0) / np.diff(times)[:, None]
-        rates[~self.covered(times, offset)] = np.nan
+    def __call__(
+        self, times: NDArray, offset: float, lag: NDArray | float = 0.0
+    ) -> NDArray[np.float64]:
+        """(N-1, 3) mean ω_imu over [t_k, t_{k+1}] + lag_k, shifted onto the gyro clock;
+        NaN rows for intervals the log does not cover."""
+        a, b = self._ends(times, offset, lag)
+        I = [
+            np.stack([np.interp(g, self.log.times, self.integral[:, i]) for i in range(3)], -1)
+            for g in (a, b)
+        ]
+        rates = (I[1] - I[0]) / (b - a)[:, None]
+        rates[~self.covered(times, offset, lag)] = np.nan
         return rates
 
-    def covered(self, times: NDArray, offset: float) -> NDArray[np.bool_]:
+    @staticmethod
+    def _ends(times: NDArray, offset: float, lag: NDArray | float) -> tuple[NDArray, NDArray]:
+        g = np.asarray(times) + offset
+        return g[:-1] + lag, g[1:] + lag
+
+    def covered(self, times: NDArray, offset: float, lag: NDArray | float = 0.0) -> NDArray:
         """Which frame intervals lie inside the log at this offset."""
         lo, hi = self.log.span
-        g = np.asarray(times) + offset
-        return (g[:-1] >= lo) & (g[1:] <= hi)
+        a, b = self._ends(times, offset, lag)
+        return (a >= lo) & (b <= hi)
 
-    def covers(self, times: NDArray, offset: float) -> bool:
+    def covers(self, times: NDArray, offset: float, lag: NDArray | float = 0.0) -> bool:
         """Whether enough of the clip (MIN_COVERAGE) lies inside the log."""
-        return bool(self.covered(times, offset).mean() >= MIN_COVERAGE)
+        return bool(self.covered(times, offset, lag).mean() >= MIN_COVERAGE)
 
 
 def coarse_offset(
     gyro: IntervalRates, times: NDArray, w_vis: NDArray, search: tuple[float, float]
 ) -> tuple[float, float]:
     """(offset, correlation) maximising the correlation of angular speeds, 1 ms grid."""
-    speed_vis = np.linalg.norm(w_vis, axis=1)
     best = (0.0, -np.inf)
     for delta in np.arange(search[0], search[1] + 5e-4, 1e-3):
-        if not gyro.covers(times, delta):
-            continue
-        speed = np.linalg.norm(gyro(times, delta), axis=1)
-        ok = np.isfinite(speed)
-        r = np.corrcoef(speed_vis[ok], speed[ok])[0, 1]
-        if np.isfinite(r) and r > best[1]:
-            best = (float(delta), float(r))
+        if gyro.covers(times, delta):
+            r = speed_correlation(gyro, times, w_vis, delta)
+            if np.isfinite(r) and r > best[1]:
+                best = (float(delta), r)
     if not np.isfinite(best[1]):
         lo, hi = gyro.log.span
         raise GyroError(
@@ -104,6 +119,15 @@ def coarse_offset(
             f"({times[-1] - times[0]:.2f} s) at any offset in {search[0]:+.2f}…{search[1]:+.2f} s"
         )
     return best
+
+
+def speed_correlation(
+    gyro: IntervalRates, times: NDArray, w_vis: NDArray, offset: float, lag: NDArray | float = 0.0
+) -> float:
+    """Correlation of the visual and the gyro angular speeds (axis-free)."""
+    speed = np.linalg.norm(gyro(times, offset, lag), axis=1)
+    ok = np.isfinite(speed)
+    return float(np.corrcoef(np.linalg.norm(w_vis, axis=1)[ok], speed[ok])[0, 1])
 
 
 def fit_axes(w_vis: NDArray, w_imu: NDArray, R: NDArray | None = None) -> tuple[NDArray, NDArray]:
@@ -127,20 +151,27 @@ def fit_axes(w_vis: NDArray, w_imu: NDArray, R: NDArray | None = None) -> tuple[
     return R, bias
 
 
-def refine_offset(
-    gyro: IntervalRates, times: NDArray, w_vis: NDArray, R: NDArray, bias: NDArray, start: float
+def rate_error(
+    gyro: IntervalRates,
+    times: NDArray,
+    w_vis: NDArray,
+    R: NDArray,
+    bias: NDArray,
+    offset: float,
+    lag: NDArray | float = 0.0,
 ) -> float:
-    """Golden-section search of Σ|w_vis - R (w_gyro(δ) - b)|² within ±5 ms, to 10 µs."""
+    """Mean squared |w_vis - R (w_gyro - b)|² at an offset; inf where the log falls short."""
+    if not gyro.covers(times, offset, lag):
+        return np.inf
+    return float(np.nanmean((w_vis - (gyro(times, offset, lag) - bias) @ R.T) ** 2))
 
-    def cost(delta: float) -> float:
-        if not gyro.covers(times, delta):
-            return np.inf
-        return float(np.nanmean((w_vis - (gyro(times, delta) - bias) @ R.T) ** 2))
 
-    a, b = start - 0.005, start + 0.005
+def golden_section(cost, lo: float, hi: float, tol: float = 1e-5) -> float:
+    """The minimiser of a unimodal ``cost`` on [lo, hi], to ``tol``."""
+    a, b = lo, hi
     c, d = b - GOLDEN * (b - a), a + GOLDEN * (b - a)
     fc, fd = cost(c), cost(d)
-    while b - a > 1e-5:
+    while b - a > tol:
         if fc < fd:
             b, d, fd = d, c, fc
             c = b - GOLDEN * (b - a)
@@ -152,22 +183,82 @@ def refine_offset(
     return 0.5 * (a + b)
 
 
+def estimate_readout(
+    gyro: IntervalRates, track: VisualTrack, R: NDArray, bias: NDArray, offset: float
+) -> tuple[float, float]:
+    """(offset of the first row, readout) from the rotations of horizontal bands.
+
+    Each band's rotations are seen at its own capture time: its best offset is
+    δ_b = δ_0 + readout · ȳ_b. A weighted line through (ȳ_b, δ_b) gives both; bands
+    whose rates fit poorly (little texture, a moving subject) weigh less. The readout is
+    kept within [0, one frame interval]; with fewer than three usable bands it is 0.
+    """
+    frame = float(np.median(np.diff(track.times)))
+    heights, offsets, weights = [], [], []
+    for R_b, rows, support in zip(track.bands, track.band_rows, track.band_support, strict=True):
+        if np.median(support) < MIN_BAND_SUPPORT:
+            continue
+        w_vis = visual_rates(track.times, R_b)
+        delta = golden_section(
+            partial(rate_error, gyro, track.times, w_vis, R, bias),
+            offset - frame,
+            offset + frame,
+        )
+        residual = rate_error(gyro, track.times, w_vis, R, bias, delta)
+        if np.isfinite(residual):
+            heights.append(float(np.mean(rows)))
+            offsets.append(delta)
+            weights.append(1.0 / max(residual, 1e-12))
+    if len(heights) < 3:
+        return offset, 0.0
+    slope = np.polyfit(heights, offsets, 1, w=np.sqrt(weights))[0]
+    readout = float(np.clip(slope, 0.0, frame))
+    first_row = float(np.average(np.array(offsets) - readout * np.array(heights), weights=weights))
+    return first_row, readout
+
+
+def refine(
+    gyro: IntervalRates,
+    times: NDArray,
+    w_vis: NDArray,
+    offset: float,
+    lag: NDArray | float,
+    fit_offset: bool,
+    R_given: NDArray | None,
+    R: NDArray,
+    bias: NDArray,
+) -> tuple[float, NDArray, NDArray]:
+    """Alternate a golden-section search of the offset (±5 ms, to 10 µs) with the axes."""
+    for _ in range(2):
+        if fit_offset:
+            offset = golden_section(
+                partial(rate_error, gyro, times, w_vis, R, bias, lag=lag),
+                offset - 0.005,
+                offset + 0.005,
+            )
+        R, bias = fit_axes(w_vis, gyro(times, offset, lag), R_given)
+    return offset, R, bias
+
+
 def synchronise(
     log: GyroLog,
-    times: NDArray,
-    R_visual: NDArray,
+    track: VisualTrack,
     *,
     search: tuple[float, float] = (-1.0, 1.0),
     offset: float | None = None,
     R_cam_imu: NDArray | None = None,
+    readout: float | None = None,
 ) -> Sync:
-    """Offset, axes and bias of ``log`` against the visual rotations at ``times``.
+    """Offset, axes, bias (and readout) of ``log`` against a clip's visual rotations.
 
-    ``offset`` or ``R_cam_imu`` given are kept (only the rest is estimated). With frame
-    times already on the gyro clock, pass ``offset=0``.
+    ``offset``, ``R_cam_imu`` or ``readout`` (s) given are kept; only the rest is
+    estimated. With frame times already on the gyro clock, pass ``offset=0``. The readout
+    is estimated when not given and the track has band rotations; otherwise it is 0 (a
+    global shutter, or the offset of the rows the rotations were seen on).
     """
     gyro = IntervalRates(log)
-    w_vis = visual_rates(times, R_visual)
+    times = track.times
+    w_vis = visual_rates(times, track.rotations)
     if offset is None:
         delta, corr = coarse_offset(gyro, times, w_vis, search)
     else:
@@ -176,12 +267,18 @@ def synchronise(
             raise GyroError(
                 f"{log.source}: the gyro log does not cover the video at offset {delta:+.3f} s"
             )
-        speed = np.linalg.norm(gyro(times, delta), axis=1)
-        ok = np.isfinite(speed)
-        corr = float(np.corrcoef(np.linalg.norm(w_vis, axis=1)[ok], speed[ok])[0, 1])
+        corr = speed_correlation(gyro, times, w_vis, delta)
     R, bias = fit_axes(w_vis, gyro(times, delta), R_cam_imu)
-    if offset is None:
-        for _ in range(2):
-            delta = refine_offset(gyro, times, w_vis, R, bias, delta)
-            R, bias = fit_axes(w_vis, gyro(times, delta), R_cam_imu)
-    return Sync(delta, R, bias, corr)
+    fit = offset is None
+    delta, R, bias = refine(gyro, times, w_vis, delta, 0.0, fit, R_cam_imu, R, bias)
+    estimated = readout is None and track.bands is not None and offset is None
+    if estimated:
+        delta, readout = estimate_readout(gyro, track, R, bias, delta)
+    readout = float(readout or 0.0)
+    if readout:
+        lag = readout * track.rows
+        if not estimated and offset is None:
+            delta -= readout * float(np.mean(track.rows))  # the content offset → first row
+        delta, R, bias = refine(gyro, times, w_vis, delta, lag, fit, R_cam_imu, R, bias)
+        corr = speed_correlation(gyro, times, w_vis, delta, lag)
+    return Sync(delta, R, bias, corr, readout, estimated)

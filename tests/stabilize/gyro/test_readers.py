@@ -55,6 +55,8 @@ def test_gcsv_scales_and_orientation(tmp_path):
         "orientation,yXz",
         "tscale,0.001",
         "gscale,0.5",
+        "frame_readout_time,15.23",
+        "frame_readout_direction,0",
         "t,gx,gy,gz",
     ]
     lines += [f"{10 * k},{2 * x},{2 * y},{2 * z}" for k, (x, y, z) in enumerate(RATES)]
@@ -64,6 +66,7 @@ def test_gcsv_scales_and_orientation(tmp_path):
     np.testing.assert_allclose(log.times, [0.0, 0.01, 0.02])
     # columns are (-y, x, -z) of the sensor: sensor x = gy, y = -gx, z = -gz
     np.testing.assert_allclose(log.rates, np.c_[RATES[:, 1], -RATES[:, 0], -RATES[:, 2]])
+    assert log.readout_s == pytest.approx(0.01523)
 
 
 def test_sensor_logger_reads_columns_by_name(tmp_path):

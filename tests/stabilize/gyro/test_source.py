@@ -82,3 +82,23 @@ def test_rotations_gcsv_option(tmp_path):
     )
     assert result.exit_code == 0, result.output
     assert read_gyro(tmp_path / "c.gcsv").rates.shape == (89, 3)
+
+
+def test_rolling_shutter_correction_from_the_gyro(tmp_path):
+    out = tmp_path / "rs.mp4"
+    args = ["run", str(SAMPLE / "clip.mp4"), str(out), "--gyro", str(SAMPLE / "gyro.csv")]
+    result = CliRunner().invoke(app, [*args, "--fov", "70", "--readout-ms", "20", "-q", "--json"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output)
+    assert summary["gyro"]["readout_ms"] == 20.0 and summary["frames"] == 90
+    # Given a readout, the offset found is the first row's: the content's (0.35 s, a global
+    # shutter) minus the readout times the mean height of the vectors, which is 0..1.
+    assert 0.35 - 0.020 < summary["gyro"]["offset_s"] < 0.35 - 0.002
+
+
+def test_readout_needs_the_gyro(tmp_path):
+    out = tmp_path / "o.mp4"
+    result = CliRunner().invoke(
+        app, ["run", str(SAMPLE / "clip.mp4"), str(out), "--readout-ms", "20", "-q"]
+    )
+    assert result.exit_code != 0 and "--gyro" in result.output and not out.exists()

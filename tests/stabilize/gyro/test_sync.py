@@ -10,6 +10,8 @@ from stabilize.cli import app
 from stabilize.gyro import GyroLog, read_gyro
 from stabilize.gyro.sync import signed_permutations, synchronise
 from stabilize.rotation_files import read_rotations
+from stabilize.synth import SynthOptions, render_clip
+from stabilize.track import VisualTrack
 
 SAMPLE = Path(__file__).resolve().parents[3] / "samples" / "street"
 
@@ -31,7 +33,7 @@ def test_there_are_24_signed_axis_rotations():
 
 def test_offset_axes_and_bias_are_found_from_the_truth(sample):
     meta, times, R, log = sample
-    sync = synchronise(log, times, R)
+    sync = synchronise(log, VisualTrack.from_rotations(times, R))
     assert abs(sync.offset - meta["offset_s"]) < 1e-3
     assert so3.angular_error_deg(sync.R_cam_imu, np.array(meta["R_cam_imu"])) < 0.5
     np.testing.assert_allclose(sync.bias, meta["gyro_bias"], atol=1e-3)
@@ -40,7 +42,7 @@ def test_offset_axes_and_bias_are_found_from_the_truth(sample):
 
 def test_given_offset_and_axes_are_kept(sample):
     _meta, times, R, log = sample
-    sync = synchronise(log, times, R, offset=0.3, R_cam_imu=np.eye(3))
+    sync = synchronise(log, VisualTrack.from_rotations(times, R), offset=0.3, R_cam_imu=np.eye(3))
     assert sync.offset == 0.3 and np.array_equal(sync.R_cam_imu, np.eye(3))
 
 
@@ -98,3 +100,59 @@ def test_a_log_that_cannot_cover_the_video_is_an_error(tmp_path):
         app, ["compare", str(SAMPLE / "clip.mp4"), "--gyro", str(path), "-q"]
     )
     assert result.exit_code != 0 and "does not cover" in result.output
+
+
+@pytest.fixture(scope="module")
+def rolling_clip(tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("rolling")
+    opts = SynthOptions(size=(270, 480), seconds=3.0, seed=5, shake_deg=1.5, rolling_shutter_ms=25)
+    render_clip(folder, opts)
+    return folder
+
+
+def test_readout_and_first_row_offset_are_estimated_under_a_rolling_shutter(rolling_clip):
+    meta = json.loads((rolling_clip / "truth.json").read_text())
+    args = [str(rolling_clip / "clip.mp4"), "--gyro", str(rolling_clip / "gyro.csv")]
+    result = CliRunner().invoke(app, ["compare", *args, "--fov", "70", "-q", "--json"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output)
+    assert summary["readout_estimated"] and abs(summary["readout_ms"] - 25.0) < 4.0
+    # About 1.2 ms here: the bands' rows are dated by where their vectors start, not by
+    # where they move to in the next frame.
+    assert abs(summary["offset_s"] - meta["offset_s"]) < 2e-3
+    # Ignoring the rolling shutter dates the rotations to the rows they were seen on:
+    # the offset found is then later by about half the readout.
+    result = CliRunner().invoke(
+        app, ["compare", *args, "--fov", "70", "--readout-ms", "0", "-q", "--json"]
+    )
+    ignored = json.loads(result.output)
+    assert ignored["offset_s"] - meta["offset_s"] > 8e-3 and ignored["readout_ms"] == 0.0
+
+
+def test_phone_cc9_offset_axes_and_readout(shared):
+    data = shared / "data" / "phone-cc9"
+    result = CliRunner().invoke(
+        app,
+        [
+            "compare",
+            str(data / "frames" / "RE_frame-%d.jpg"),
+            "--start-number",
+            "99",
+            "--gyro",
+            str(data / "gyro.txt"),
+            "--timestamps",
+            str(data / "framestamp.txt"),
+            "--focal",
+            "573.85",
+            "-q",
+            "--json",
+        ],
+    )
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output)
+    # The data README: offset 0 ± 4 ms from the frame start; gyro x is camera y and
+    # gyro y camera x.
+    assert abs(summary["offset_s"]) < 4e-3
+    assert summary["axes"][:2].lower() == "yx" and summary["frames"] == 102
+    assert 10.0 < summary["readout_ms"] < 33.4
+    assert summary["aae_deg"] < 0.15 and summary["warning"] is None

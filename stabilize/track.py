@@ -1,0 +1,57 @@
+"""The visual estimate of a clip: one rotation per frame pair, and where it was seen.
+
+Under a rolling shutter the rows of a frame are captured one after another, row y at
+``t + readout · y/H``. A rotation measured from flow vectors around height ȳ therefore
+belongs to the times ``t_k + readout · ȳ`` and ``t_{k+1} + readout · ȳ``, not to the frame
+times themselves. ``rows`` keeps ȳ per pair (0 top, 1 bottom) for that reason, and
+``bands`` the rotations measured from separate horizontal bands of the frame, from which
+the readout time can be estimated (:func:`stabilize.gyro.sync.estimate_readout`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rotation import RotationEstimate
+
+
+@dataclass(frozen=True)
+class VisualTrack:
+    times: NDArray[np.float64]  # (N,) s, video clock: when each frame's first row is captured
+    rotations: NDArray[np.float64]  # (N-1, 3, 3) R_t
+    support: NDArray[np.float64]  # (N-1,) share of the flow vectors that agree
+    rows: NDArray[np.float64]  # (N-1,) mean height of those vectors, 0 top .. 1 bottom
+    bands: NDArray[np.float64] | None = None  # (B, N-1, 3, 3) R_t from each band alone
+    band_rows: NDArray[np.float64] | None = None  # (B, N-1) their mean heights
+    band_support: NDArray[np.float64] | None = None  # (B, N-1)
+
+    @classmethod
+    def from_rotations(cls, times: NDArray, rotations: NDArray) -> VisualTrack:
+        """A track without row information (the middle row for every pair)."""
+        rotations = np.asarray(rotations, dtype=np.float64)
+        n = len(rotations)
+        return cls(np.asarray(times, np.float64), rotations, np.ones(n), np.full(n, 0.5))
+
+    def pairs(self, first: int, stop: int) -> VisualTrack:
+        """The pairs first..stop-1 (frames first..stop)."""
+        cut = (lambda a: None) if self.bands is None else (lambda a: a[:, first:stop])
+        return VisualTrack(
+            self.times[first : stop + 1],
+            self.rotations[first:stop],
+            self.support[first:stop],
+            self.rows[first:stop],
+            cut(self.bands),
+            cut(self.band_rows),
+            cut(self.band_support),
+        )
+
+
+def mean_row(estimate: RotationEstimate, sample_rows: NDArray, height: int) -> float:
+    """Mean height (0 top .. 1 bottom) of the flow vectors that agreed with an estimate."""
+    per_row = estimate.inliers.sum(axis=1)
+    if per_row.sum() == 0:
+        return 0.5
+    return float(np.average(sample_rows + 0.5, weights=per_row) / height)
