@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import json
 import sys
+from dataclasses import replace
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import NoReturn
@@ -216,6 +217,7 @@ def _settings(flow_name: str, raft_weights: Path | None, device: str, **options)
     return Settings(flow=flow_name, flow_options=flow_options, **options)
 
 
+FOCAL_ROUNDS = 3  # re-estimations when fitting the focal length to the gyro
 FLOW_HELP = "Optical flow: dis (fast, CPU), raft or raft-large (needs weights)."
 
 
@@ -261,6 +263,7 @@ def run(
     gyro_offset: float | None = typer.Option(None, help="Gyro minus video clock, s."),
     gyro_axes: str | None = typer.Option(None, help="IMU axis of camera x, y, z, e.g. YXz."),
     gyro_lpf: float | None = typer.Option(None, help="Low-pass the gyro at this many Hz."),
+    gyro_drift: bool = typer.Option(False, "--gyro-drift", help="Also fit a clock drift."),
     readout_ms: str | None = typer.Option(
         None,
         help="Rolling-shutter readout, ms, or 'auto' to estimate it (with --gyro). "
@@ -296,6 +299,7 @@ def run(
         gyro_axes=None if gyro_axes is None else tuple(map(tuple, _axes(gyro_axes))),
         gyro_lpf=gyro_lpf,
         readout_ms=_readout(readout_ms, gyro),
+        gyro_drift=gyro_drift,
     )
     with contextlib.ExitStack() as stack:
 
@@ -405,7 +409,8 @@ def _axes(code: str | None):
         "  stabilize compare clip.mp4 --gyro gyro.csv --report cmp/\n\n"
         "  stabilize compare 'frames/RE_frame-%d.jpg' --start-number 99 --gyro gyro.txt "
         "--timestamps framestamp.txt --focal 573.85 --json\n\n"
-        "  stabilize compare clip.mp4 --gyro log.gcsv --offset 0.042 --axes YXz"
+        "  stabilize compare clip.mp4 --gyro log.gcsv --offset 0.042 --axes YXz\n\n"
+        "  stabilize compare clip.mp4 --gyro gyro.csv --calibrate-focal --drift"
     )
 )
 def compare(
@@ -427,6 +432,12 @@ def compare(
         help="Rolling-shutter readout, ms (0: global shutter), or 'auto': the log's value, "
         "else estimated from bands of the frame.",
     ),
+    drift: bool = typer.Option(False, "--drift", help="Also fit a linear clock drift."),
+    calibrate_focal: bool = typer.Option(
+        False,
+        "--calibrate-focal",
+        help="Fit the focal length to the gyro (estimates the rotations again with it).",
+    ),
     flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
     raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
     report: Path | None = typer.Option(None, help="Write pairs.csv, summary.json and plots here."),
@@ -436,6 +447,7 @@ def compare(
     """Compare the visual rotation estimate with a gyroscope log."""
     from stabilize import compare as cmp
     from stabilize.gyro import GyroError, read_gyro
+    from stabilize.gyro.focal import focal_from_gyro
     from stabilize.gyro.readers import read_frame_timestamps_s
     from stabilize.gyro.sync import synchronise
     from stabilize.pipeline import READOUT_BANDS, estimate_rotations, readout_seconds
@@ -462,20 +474,33 @@ def compare(
         parsed = _readout(readout_ms, gyro)
         readout = log.readout_s if parsed == "auto" else readout_seconds(parsed, None)
         bands = READOUT_BANDS if readout is None else 0
-        with progress_bar("estimating", n - 1, quiet=quiet) as advance:
-            track = estimate_rotations(video, info, settings, advance, times, bands=bands)
-        sync = synchronise(
-            log,
-            track,
-            search=(-search, search),
-            offset=offset,
-            R_cam_imu=R_cam_imu,
-            readout=readout,
-        )
+
+        def estimate_and_sync(settings):
+            with progress_bar("estimating", n - 1, quiet=quiet) as advance:
+                track = estimate_rotations(video, info, settings, advance, times, bands=bands)
+            sync = synchronise(
+                log,
+                track,
+                search=(-search, search),
+                offset=offset,
+                R_cam_imu=R_cam_imu,
+                readout=readout,
+                fit_drift=drift,
+            )
+            return track, sync
+
+        track, sync = estimate_and_sync(settings)
+        for _ in range(FOCAL_ROUNDS if calibrate_focal else 0):
+            old = settings.focal_px(info.width)
+            fitted = focal_from_gyro(track, log, sync, old)
+            settings = replace(settings, focal=fitted)
+            track, sync = estimate_and_sync(settings)
+            if abs(fitted / old - 1.0) < 0.005:
+                break
         result = cmp.compare(track, log, sync, settings.focal_px(info.width))
     except (VideoError, GyroError, ValueError) as err:
         _fail(str(err))
-    summary = result.summary()
+    summary = result.summary() | {"focal_calibrated": calibrate_focal}
     if report is not None:
         cmp.write_report(report, result)
     if summary["warning"]:

@@ -72,6 +72,7 @@ class Comparison:
             "offset_s": self.sync.offset,
             "readout_ms": 1000.0 * self.sync.readout,
             "readout_estimated": self.sync.readout_estimated,
+            "drift_ppm": 1e6 * self.sync.drift,
             "aae_deg": float(err.mean()),
             "median_deg": float(np.median(err)),
             "p95_deg": float(np.percentile(err, 95)),
@@ -105,11 +106,13 @@ def compare(track: VisualTrack, log: GyroLog, sync: Sync, focal: float) -> Compa
     Under a rolling shutter each pair's gyro interval is shifted to the capture time of
     the rows its visual rotation was seen on (``sync.lag``).
     """
-    inside = IntervalRates(log).covered(track.times, sync.offset, sync.lag(track))
+    clock = sync.clock(track.times)
+    inside = IntervalRates(log).covered(clock, sync.offset, sync.lag(track))
     first, last = np.flatnonzero(inside)[[0, -1]]
     track = track.pairs(first, last + 1)
     unbiased = replace(log, rates=log.rates - sync.bias)
-    gyro = integrate_rotations(unbiased, track.times, sync.offset, sync.R_cam_imu, sync.lag(track))
+    clock = sync.clock(track.times)
+    gyro = integrate_rotations(unbiased, clock, sync.offset, sync.R_cam_imu, sync.lag(track))
     errors = so3.angular_error_deg(track.rotations, gyro)
     return Comparison(track.times, track.rotations, gyro, errors, sync, focal, log.rate_hz)
 

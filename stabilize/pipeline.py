@@ -60,6 +60,7 @@ class Settings:
     gyro_axes: tuple | None = None  # R_cam_imu as nested tuples
     gyro_lpf: float | None = None  # Hz
     readout_ms: float | str | None = None  # rolling shutter: ms, 'auto', or the log's value
+    gyro_drift: bool = False  # also fit a linear clock drift
     encoding: Encoding = field(default_factory=Encoding)
 
     def focal_px(self, width: int) -> float:
@@ -285,12 +286,16 @@ def _from_gyro(
     axes = None if settings.gyro_axes is None else np.array(settings.gyro_axes, dtype=float)
     readout = readout_seconds(settings.readout_ms, log.readout_s)
     att, sync = gyro_rotations(
-        log, track, offset=settings.gyro_offset, R_cam_imu=axes, readout=readout
+        log,
+        track,
+        offset=settings.gyro_offset,
+        R_cam_imu=axes,
+        readout=readout,
+        fit_drift=settings.gyro_drift,
     )
-    R = frame_rotations(att, track.times, sync.offset, sync.readout)
-    rolling = (
-        row_turns(att, track.times, sync.offset, sync.readout, height) if sync.readout else None
-    )
+    clock = sync.clock(track.times)
+    R = frame_rotations(att, clock, sync.offset, sync.readout)
+    rolling = row_turns(att, clock, sync.offset, sync.readout, height) if sync.readout else None
     return (
         R,
         rolling,

@@ -29,6 +29,7 @@ def gyro_rotations(
     offset: float | None = None,
     R_cam_imu: NDArray | None = None,
     readout: float | None = 0.0,
+    fit_drift: bool = False,
     search: float = 1.0,
 ) -> tuple[Attitude, Sync]:
     """The camera attitude from the gyro, synchronised against the visual estimate, bias
@@ -44,6 +45,7 @@ def gyro_rotations(
         offset=offset,
         R_cam_imu=R_cam_imu,
         readout=readout,
+        fit_drift=fit_drift,
     )
     if sync.correlation < MIN_CORRELATION:
         raise GyroError(

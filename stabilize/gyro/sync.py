@@ -30,6 +30,7 @@ from stabilize.track import VisualTrack
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 MIN_CORRELATION = 0.6  # of angular speeds, below which a log does not match the video
 MIN_COVERAGE = 0.8  # share of the frame pairs the log must cover (camera logs stop early)
+MAX_DRIFT = 2e-3  # clock-rate difference searched with fit_drift (crystals: ~1e-5..1e-4)
 MIN_BAND_SUPPORT = 0.05  # a band with so few agreeing vectors says little about its time
 
 
@@ -41,10 +42,22 @@ class Sync:
     correlation: float  # of the angular speeds at the offset
     readout: float = 0.0  # s, rolling-shutter readout (first to last row); 0: global
     readout_estimated: bool = False
+    drift: float = 0.0  # gyro clock rate minus video clock rate (1e-6 = 1 ppm)
+    origin: float = 0.0  # video time at which ``offset`` holds exactly
 
     def lag(self, track: VisualTrack) -> NDArray[np.float64]:
         """Per pair, when its rotation was seen after the first row: readout × mean height."""
         return self.readout * track.rows
+
+    def clock(self, times: NDArray) -> NDArray[np.float64]:
+        """Video times as the gyro clock runs (before the offset): t + drift·(t - origin)."""
+        return drifted(times, self.drift, self.origin)
+
+
+def drifted(times: NDArray, drift: float, origin: float) -> NDArray[np.float64]:
+    """t + drift·(t - origin): a gyro clock running at 1 + drift times the video's rate."""
+    times = np.asarray(times, dtype=np.float64)
+    return times + drift * (times - origin)
 
 
 def signed_permutations() -> list[NDArray[np.float64]]:
@@ -248,13 +261,17 @@ def synchronise(
     offset: float | None = None,
     R_cam_imu: NDArray | None = None,
     readout: float | None = None,
+    fit_drift: bool = False,
+    max_drift: float = MAX_DRIFT,
 ) -> Sync:
     """Offset, axes, bias (and readout) of ``log`` against a clip's visual rotations.
 
     ``offset``, ``R_cam_imu`` or ``readout`` (s) given are kept; only the rest is
     estimated. With frame times already on the gyro clock, pass ``offset=0``. The readout
     is estimated when not given and the track has band rotations; otherwise it is 0 (a
-    global shutter, or the offset of the rows the rotations were seen on).
+    global shutter, or the offset of the rows the rotations were seen on). ``fit_drift``
+    also fits a linear clock drift within ±``max_drift`` (long clips; a few ms over the
+    clip are needed to see it).
     """
     gyro = IntervalRates(log)
     times = track.times
@@ -281,4 +298,18 @@ def synchronise(
             delta -= readout * float(np.mean(track.rows))  # the content offset → first row
         delta, R, bias = refine(gyro, times, w_vis, delta, lag, fit, R_cam_imu, R, bias)
         corr = speed_correlation(gyro, times, w_vis, delta, lag)
-    return Sync(delta, R, bias, corr, readout, estimated)
+    drift = 0.0
+    if fit_drift:
+        lag = readout * track.rows
+
+        def cost(eps: float) -> float:
+            d = refine(
+                gyro, drifted(times, eps, times[0]), w_vis, delta, lag, fit, R_cam_imu, R, bias
+            )[0]
+            return rate_error(gyro, drifted(times, eps, times[0]), w_vis, R, bias, d, lag)
+
+        drift = golden_section(cost, -max_drift, max_drift, tol=1e-7)
+        delta, R, bias = refine(
+            gyro, drifted(times, drift, times[0]), w_vis, delta, lag, fit, R_cam_imu, R, bias
+        )
+    return Sync(delta, R, bias, corr, readout, estimated, drift, float(times[0]))

@@ -156,3 +156,25 @@ def test_phone_cc9_offset_axes_and_readout(shared):
     assert summary["axes"][:2].lower() == "yx" and summary["frames"] == 102
     assert 10.0 < summary["readout_ms"] < 33.4
     assert summary["aae_deg"] < 0.15 and summary["warning"] is None
+
+
+def test_a_linear_clock_drift_is_fitted(sample):
+    meta, times, R, log = sample
+    drift = 1e-3  # the gyro clock runs 1000 ppm fast: 3 ms over the clip
+    start = meta["offset_s"]
+    fast = GyroLog(start + (log.times - start) * (1 + drift), log.rates / (1 + drift), "fast")
+    track = VisualTrack.from_rotations(times, R)
+    assert abs(synchronise(fast, track).drift) == 0.0
+    sync = synchronise(fast, track, fit_drift=True)
+    assert abs(sync.drift - drift) < 1e-4
+    assert abs(sync.offset - start) < 2e-4
+
+
+def test_the_focal_length_is_calibrated_against_the_gyro():
+    meta = json.loads((SAMPLE / "truth.json").read_text())
+    args = ["compare", str(SAMPLE / "clip.mp4"), "--gyro", str(SAMPLE / "gyro.csv")]
+    result = CliRunner().invoke(app, [*args, "--fov", "60", "--calibrate-focal", "-q", "--json"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output)
+    assert summary["focal_calibrated"]
+    assert summary["focal_px"] == pytest.approx(meta["focal_px"], rel=0.03)  # from 554 px
