@@ -31,6 +31,7 @@ GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 MIN_CORRELATION = 0.6  # of angular speeds, below which a log does not match the video
 MIN_COVERAGE = 0.8  # share of the frame pairs the log must cover (camera logs stop early)
 MAX_DRIFT = 2e-3  # clock-rate difference searched with fit_drift (crystals: ~1e-5..1e-4)
+MAX_READOUT_STDERR = 0.15  # of a frame interval: a less certain readout is not used
 MIN_BAND_SUPPORT = 0.05  # a band with so few agreeing vectors says little about its time
 
 
@@ -198,13 +199,15 @@ def golden_section(cost, lo: float, hi: float, tol: float = 1e-5) -> float:
 
 def estimate_readout(
     gyro: IntervalRates, track: VisualTrack, R: NDArray, bias: NDArray, offset: float
-) -> tuple[float, float]:
+) -> tuple[float, float | None]:
     """(offset of the first row, readout) from the rotations of horizontal bands.
 
     Each band's rotations are seen at its own capture time: its best offset is
     δ_b = δ_0 + readout · ȳ_b. A weighted line through (ȳ_b, δ_b) gives both; bands
     whose rates fit poorly (little texture, a moving subject) weigh less. The readout is
-    kept within [0, one frame interval]; with fewer than three usable bands it is 0.
+    kept within [0, one frame interval]. Without three usable bands, or when the slope is
+    too uncertain (smooth, slow motion dates the bands poorly), the answer is None and
+    ``offset`` is returned unchanged.
     """
     frame = float(np.median(np.diff(track.times)))
     heights, offsets, weights = [], [], []
@@ -223,11 +226,18 @@ def estimate_readout(
             offsets.append(delta)
             weights.append(1.0 / max(residual, 1e-12))
     if len(heights) < 3:
-        return offset, 0.0
-    slope = np.polyfit(heights, offsets, 1, w=np.sqrt(weights))[0]
+        return offset, None
+    x, y, w = np.array(heights), np.array(offsets), np.array(weights)
+    slope, intercept = np.polyfit(x, y, 1, w=np.sqrt(w))
+    dof = max(len(x) - 2, 1)
+    spread = np.sum(w * (x - np.average(x, weights=w)) ** 2)
+    sigma2 = np.sum(w * (y - slope * x - intercept) ** 2) / dof
+    stderr = float(np.sqrt(sigma2 / spread)) if spread > 0 else np.inf
+    # A slope that the bands do not pin down, or one no shutter can have, is no estimate.
+    if stderr > MAX_READOUT_STDERR * frame or not -0.1 * frame < slope < 1.1 * frame:
+        return offset, None
     readout = float(np.clip(slope, 0.0, frame))
-    first_row = float(np.average(np.array(offsets) - readout * np.array(heights), weights=weights))
-    return first_row, readout
+    return float(np.average(y - readout * x, weights=w)), readout
 
 
 def refine(
@@ -291,6 +301,7 @@ def synchronise(
     estimated = readout is None and track.bands is not None and offset is None
     if estimated:
         delta, readout = estimate_readout(gyro, track, R, bias, delta)
+        estimated = readout is not None
     readout = float(readout or 0.0)
     if readout:
         lag = readout * track.rows
