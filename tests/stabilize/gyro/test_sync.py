@@ -8,7 +8,7 @@ from typer.testing import CliRunner
 from rotation import so3
 from stabilize.cli import app
 from stabilize.gyro import GyroLog, read_gyro
-from stabilize.gyro.sync import signed_permutations, synchronise
+from stabilize.gyro.sync import signed_permutations, synchronise, visual_rates
 from stabilize.rotation_files import read_rotations
 from stabilize.synth import SynthOptions, render_clip
 from stabilize.track import VisualTrack
@@ -178,3 +178,21 @@ def test_the_focal_length_is_calibrated_against_the_gyro():
     summary = json.loads(result.output)
     assert summary["focal_calibrated"]
     assert summary["focal_px"] == pytest.approx(meta["focal_px"], rel=0.03)  # from 554 px
+
+
+def test_the_axes_refinement_is_kept_only_where_the_data_support_it(sample):
+    meta, times, R, log = sample
+    # Visual rates with the kind of error parallax leaves (sample clips: 0.5-0.9°/s): noise,
+    # and a little pitch that follows the yaw rate, which plain Kabsch reads as a tilt.
+    w = visual_rates(times, R)
+    rng = np.random.default_rng(4)
+    w += rng.normal(0, np.radians(0.8), w.shape)
+    w[:, 0] += 0.01 * w[:, 1]
+    track = VisualTrack.from_rotations(times, so3.exp_so3(-w * np.diff(times)[:, None]))
+    true_axes = np.array(meta["R_cam_imu"])
+    square = synchronise(log, track)
+    assert so3.angular_error_deg(square.R_cam_imu, true_axes) < 1e-9  # the permutation
+    T = so3.exp_so3(np.radians([0.6, 0.8, 0.0]) * 5.0)  # an IMU mounted 5° off
+    tilted = synchronise(GyroLog(log.times, log.rates @ T.T, "tilted"), track)
+    assert so3.angular_error_deg(tilted.R_cam_imu, true_axes @ T.T) < 1.0
+    assert so3.angular_error_deg(tilted.R_cam_imu, true_axes) > 4.0
