@@ -229,6 +229,7 @@ FLOW_HELP = "Optical flow: dis (fast, CPU), raft or raft-large (needs weights)."
         "  stabilize shaky.mp4 steady.mp4\n\n"
         "  stabilize shaky.mp4 steady.mp4 --smooth 1.0 --max-zoom 1.3 --report report/\n\n"
         "  stabilize drone.mp4 locked.mp4 --lock --crop dynamic\n\n"
+        "  stabilize gopro.mp4 out.mp4 --lens 'GoPro_HERO7 Black_Wide_16by9.json'\n\n"
         "  stabilize in.mp4 out.mp4 --flow raft --raft-weights raft-small.pth --device cuda"
     ),
 )
@@ -242,6 +243,9 @@ def run(
         None, help="Horizontal field of view, deg (default 69: a phone's main camera)."
     ),
     focal: float | None = typer.Option(None, help="Focal length in pixels (overrides --fov)."),
+    lens: Path | None = typer.Option(
+        None, help="Gyroflow lens profile (.json, OpenCV fisheye): overrides --fov/--focal."
+    ),
     smooth: float = typer.Option(0.5, min=0.01, help="Smoothing time constant, s."),
     method: str = typer.Option("adaptive", help="adaptive (follows pans) or gaussian."),
     lock: bool = typer.Option(False, help="Hold one orientation, like a tripod."),
@@ -300,6 +304,7 @@ def run(
         gyro_lpf=gyro_lpf,
         readout_ms=_readout(readout_ms, gyro),
         gyro_drift=gyro_drift,
+        lens=str(lens) if lens else None,
     )
     with contextlib.ExitStack() as stack:
 
@@ -424,6 +429,9 @@ def compare(
     fps: float | None = typer.Option(None, help="Frame rate of an image sequence."),
     fov: float | None = typer.Option(None, help="Horizontal field of view, deg (default 69)."),
     focal: float | None = typer.Option(None, help="Focal length in pixels (overrides --fov)."),
+    lens: Path | None = typer.Option(
+        None, help="Gyroflow lens profile (.json, OpenCV fisheye): overrides --fov/--focal."
+    ),
     offset: float | None = typer.Option(None, help="Gyro minus video clock, s (skip the search)."),
     axes: str | None = typer.Option(None, help="IMU axis of camera x, y, z, e.g. YXz."),
     search: float = typer.Option(1.0, min=0.0, help="Offset search range, ± seconds."),
@@ -450,6 +458,7 @@ def compare(
     from stabilize.gyro.focal import focal_from_gyro
     from stabilize.gyro.readers import read_frame_timestamps_s
     from stabilize.gyro.sync import synchronise
+    from stabilize.lens import read_lens_profile
     from stabilize.pipeline import READOUT_BANDS, estimate_rotations, readout_seconds
     from stabilize.progress import progress_bar
     from stabilize.video_reader import VideoError, frame_times, probe, sequence_args
@@ -470,14 +479,22 @@ def compare(
             times = stamps[first : first + n]
             if len(times) < n:
                 _fail(f"{timestamps}: {len(stamps)} frame times, the video needs {first + n}")
+        camera = read_lens_profile(lens, info.size) if lens else None
+        if camera is not None and calibrate_focal:
+            _fail("--calibrate-focal fits a pinhole focal length; --lens brings its own")
+        if camera is not None:
+            settings = replace(settings, focal=float(camera.K[0, 0]))
         # Unlike the stabiliser, compare estimates (None) a readout the log does not give.
         parsed = _readout(readout_ms, gyro)
-        readout = log.readout_s if parsed == "auto" else readout_seconds(parsed, None)
+        given = log.readout_s or (camera and camera.readout_s)
+        readout = given if parsed == "auto" else readout_seconds(parsed, None)
         bands = READOUT_BANDS if readout is None else 0
 
         def estimate_and_sync(settings):
             with progress_bar("estimating", n - 1, quiet=quiet) as advance:
-                track = estimate_rotations(video, info, settings, advance, times, bands=bands)
+                track = estimate_rotations(
+                    video, info, settings, advance, times, bands=bands, lens=camera
+                )
             sync = synchronise(
                 log,
                 track,

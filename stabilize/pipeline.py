@@ -13,17 +13,19 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
+import cv2
 import ffmpeg
 import numpy as np
 from numpy.typing import NDArray
 
 import flow
 from rotation import HoughEstimator, so3
-from rotation.camera import focal_from_fov, intrinsics
+from rotation.camera import focal_from_fov, intrinsics, scale_intrinsics
 from stabilize.ffmpeg_tools import atomic_output
+from stabilize.lens import Lens, pinhole_map, read_lens_profile
 from stabilize.rolling_shutter import RollingShutter
 from stabilize.smoothing import (
     orientations_from_rotations,
@@ -33,7 +35,13 @@ from stabilize.smoothing import (
 from stabilize.track import VisualTrack, mean_row
 from stabilize.video_reader import VideoError, VideoInfo, frame_times, probe, read_frames
 from stabilize.video_writer import Encoding, FrameWriter
-from stabilize.warping import homography, required_zoom, warp_frame, warp_frame_rolling
+from stabilize.warping import (
+    homography,
+    required_zoom,
+    warp_frame,
+    warp_frame_lens,
+    warp_frame_rolling,
+)
 
 # A phone's main camera is about 26 mm full-frame equivalent: 69° across the long side.
 DEFAULT_HFOV = 69.0
@@ -61,6 +69,7 @@ class Settings:
     gyro_lpf: float | None = None  # Hz
     readout_ms: float | str | None = None  # rolling shutter: ms, 'auto', or the log's value
     gyro_drift: bool = False  # also fit a linear clock drift
+    lens: str | None = None  # a Gyroflow lens profile (OpenCV fisheye)
     encoding: Encoding = field(default_factory=Encoding)
 
     def focal_px(self, width: int) -> float:
@@ -84,6 +93,18 @@ class CameraPath:
     # Rolling shutter: the homographies of each knot row (N, B, 3, 3) at input rows (B,).
     row_homographies: NDArray | None = None
     knot_rows: NDArray | None = None
+    row_corrections: NDArray | None = None  # (N, B, 3, 3)
+    lens: Lens | None = None  # fisheye: frames are warped through it, not by homographies
+
+    def warp(self, k: int, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        """Frame k of the output."""
+        if self.lens is not None:
+            rolling = self.row_corrections is not None
+            C = self.row_corrections[k] if rolling else self.smooth[k] @ self.raw[k].T
+            return warp_frame_lens(frame, self.lens, C, self.zoom[k], self.knot_rows)
+        if self.row_homographies is None:
+            return warp_frame(frame, self.homographies[k])
+        return warp_frame_rolling(frame, self.row_homographies[k], self.knot_rows)
 
 
 Progress = Callable[[int], None]
@@ -101,19 +122,29 @@ def estimate_rotations(
     times: NDArray | None = None,
     *,
     bands: int = 0,
+    lens: Lens | None = None,
 ) -> VisualTrack:
     """Pass 1: the clip's rotations, frames streamed at the working size.
 
     Frame times are the container's timestamps unless given (e.g. from a sensor log).
     ``bands`` > 0 also estimates each pair's rotation from that many horizontal bands of
     the frame alone (for the rolling-shutter readout; about 0.5 ms per band and pair).
+    With a fisheye ``lens`` the frames are first remapped to a pinhole view.
     """
     times = frame_times(path, info.input_args) if times is None else np.asarray(times)
     if len(times) < 2:
         raise VideoError(f"{path}: has {len(times)} frame(s); nothing to stabilise")
     ws = flow.working_size(info.size)
-    focal = settings.focal_px(info.width) * ws.scale[0]
-    estimator = HoughEstimator(ws.size, focal, max_deg=settings.max_deg)
+    frames = read_frames(path, ws.size, info)
+    if lens is None:
+        focal = settings.focal_px(info.width) * ws.scale[0]
+        estimator = HoughEstimator(ws.size, focal, max_deg=settings.max_deg)
+    else:
+        K_ws = scale_intrinsics(lens.K, *ws.scale)
+        focal, center = float(K_ws[0, 0]), (float(K_ws[0, 2]), float(K_ws[1, 2]))
+        estimator = HoughEstimator(ws.size, focal, center=center, max_deg=settings.max_deg)
+        maps = pinhole_map(replace(lens, K=K_ws), ws.size, focal, center)
+        frames = (cv2.remap(f, *maps, cv2.INTER_LINEAR) for f in frames)
     sample_rows = estimator.grid.rows
     backend = flow.get(settings.flow, **settings.flow_options)
     height = ws.size[0]
@@ -133,7 +164,7 @@ def estimate_rotations(
         progress(len(chunk))
         chunk.clear()
 
-    for f in backend.many(read_frames(path, ws.size, info)):
+    for f in backend.many(frames):
         chunk.append(f)
         if len(chunk) == ESTIMATE_CHUNK:
             flush()
@@ -195,6 +226,7 @@ def plan(
     size: tuple[int, int],
     settings: Settings,
     rolling: RollingShutter | None = None,
+    lens: Lens | None = None,
 ) -> CameraPath:
     """Smooth the path, keep it within the zoom budget, and choose each frame's zoom.
 
@@ -224,11 +256,10 @@ def plan(
     C = S @ np.swapaxes(O, -1, -2)
     H = np.array([homography(K, c, z) for c, z in zip(C, zoom, strict=True)])
     if rolling is None:
-        return CameraPath(times, rotations, support, O, S, zoom, H, K)
-    H_rows = np.array(
-        [homography(K, c, z) for cs, z in zip(corrections(S), zoom, strict=True) for c in cs]
-    ).reshape(len(O), len(rows), 3, 3)
-    return CameraPath(times, rotations, support, O, S, zoom, H, K, H_rows, rows)
+        return CameraPath(times, rotations, support, O, S, zoom, H, K, lens=lens)
+    C_rows = corrections(S)
+    H_rows = np.array([homography(K, c, z) for c, z in zip(C_rows, zoom, strict=True)])
+    return CameraPath(times, rotations, support, O, S, zoom, H, K, H_rows, rows, C_rows, lens)
 
 
 def choose_zoom(need: NDArray, times: NDArray, settings: Settings) -> NDArray:
@@ -261,10 +292,7 @@ def render(
     size = (h, 2 * w) if settings.preview else (h, w)
     with FrameWriter(out, size, fps, settings.encoding, audio, copy_audio=True) as writer:
         for k, frame in zip(range(len(planned.zoom)), read_frames(path, info=info), strict=False):
-            if planned.row_homographies is None:
-                warped = warp_frame(frame, planned.homographies[k])
-            else:
-                warped = warp_frame_rolling(frame, planned.row_homographies[k], planned.knot_rows)
+            warped = planned.warp(k, frame)
             writer.write(np.hstack([frame, warped]) if settings.preview else warped)
             written += 1
             progress(1)
@@ -272,7 +300,7 @@ def render(
 
 
 def _from_gyro(
-    settings: Settings, track: VisualTrack, height: int
+    settings: Settings, track: VisualTrack, height: int, lens: Lens | None = None
 ) -> tuple[NDArray, RollingShutter | None, dict]:
     """R_t from the gyro log named in settings, synchronised against the visual estimate,
     and the per-row turns when the readout time is known (or estimated)."""
@@ -284,7 +312,7 @@ def _from_gyro(
     if settings.gyro_lpf:
         log = lowpass(log, settings.gyro_lpf)
     axes = None if settings.gyro_axes is None else np.array(settings.gyro_axes, dtype=float)
-    readout = readout_seconds(settings.readout_ms, log.readout_s)
+    readout = readout_seconds(settings.readout_ms, log.readout_s or (lens and lens.readout_s))
     att, sync = gyro_rotations(
         log,
         track,
@@ -343,17 +371,21 @@ def stabilize_video(
     info = probe(src)
     start = time.perf_counter()
     bar = progress or (lambda label, total: _no_progress)
+    lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
     bands = READOUT_BANDS if settings.gyro and settings.readout_ms == "auto" else 0
-    track = estimate_rotations(src, info, settings, bar("estimating", None), bands=bands)
+    track = estimate_rotations(src, info, settings, bar("estimating", None), bands=bands, lens=lens)
     times, support = track.times, track.support
     gyro_summary, rolling = None, None
     if settings.gyro:
-        R, rolling, gyro_summary = _from_gyro(settings, track, info.height)
+        R, rolling, gyro_summary = _from_gyro(settings, track, info.height, lens)
     else:
         R, reliable = repair_unreliable(track.rotations, support)
     t_estimate = time.perf_counter() - start
-    K = intrinsics(settings.focal_px(info.width), info.size)
-    planned = plan(times, R, support, K, info.size, settings, rolling)
+    if lens is None:
+        K = intrinsics(settings.focal_px(info.width), info.size)
+    else:  # the homographies reported are the pinhole part of the lens
+        K = intrinsics(lens.K[0, 0], info.size, (lens.K[0, 2], lens.K[1, 2]))
+    planned = plan(times, R, support, K, info.size, settings, rolling, lens)
     t_plan = time.perf_counter() - start - t_estimate
     with atomic_output(dst, overwrite=overwrite) as tmp:
         frames = render(src, tmp, info, planned, settings, bar("stabilising", len(times)))

@@ -23,6 +23,8 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from stabilize.lens import Lens, project, unproject
+
 BORDER_SAMPLES = 16  # points per edge checked for coverage
 ROW_ITERATIONS = 2  # fixed-point steps for an output pixel's source row
 MAP_STEP = 8  # output pixels between exactly computed points of a rolling-shutter map
@@ -81,17 +83,29 @@ def inverses(H: NDArray) -> NDArray[np.float64]:
 
 
 def covers(
-    K: NDArray, C: NDArray, zoom: float, size: tuple[int, int], rows: NDArray | None = None
+    K: NDArray,
+    C: NDArray,
+    zoom: float,
+    size: tuple[int, int],
+    rows: NDArray | None = None,
+    lens: Lens | None = None,
 ) -> bool:
     """Whether the output frame at ``zoom`` lies entirely inside the warped input.
 
-    ``C`` is one correction, or one per knot row in ``rows`` (rolling shutter).
+    ``C`` is one correction, or one per knot row in ``rows`` (rolling shutter); with a
+    ``lens`` the border is mapped through it instead of a homography.
     """
     h, w = size
-    pts = back_project(inverses(homography(K, C, zoom)), rows, _border(size))
-    if np.any(pts[:, 2] <= 0):
-        return False
-    x, y = pts[:, 0] / pts[:, 2], pts[:, 1] / pts[:, 2]
+    if lens is not None:
+        xy = lens_source(lens, C, zoom, _border(size), rows)
+        if not np.isfinite(xy).all():
+            return False
+        x, y = xy[:, 0], xy[:, 1]
+    else:
+        pts = back_project(inverses(homography(K, C, zoom)), rows, _border(size))
+        if np.any(pts[:, 2] <= 0):
+            return False
+        x, y = pts[:, 0] / pts[:, 2], pts[:, 1] / pts[:, 2]
     return bool(np.all((x >= -0.5) & (x <= w - 0.5) & (y >= -0.5) & (y <= h - 0.5)))
 
 
@@ -101,16 +115,17 @@ def required_zoom(
     size: tuple[int, int],
     max_zoom: float = 4.0,
     rows: NDArray | None = None,
+    lens: Lens | None = None,
 ) -> float:
     """The smallest zoom ≥ 1 with no border in frame (bisection); inf if above max_zoom."""
-    if covers(K, C, 1.0, size, rows):
+    if covers(K, C, 1.0, size, rows, lens):
         return 1.0
-    if not covers(K, C, max_zoom, size, rows):
+    if not covers(K, C, max_zoom, size, rows, lens):
         return np.inf
     lo, hi = 1.0, max_zoom
     for _ in range(30):
         mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if covers(K, C, mid, size, rows) else (mid, hi)
+        lo, hi = (lo, mid) if covers(K, C, mid, size, rows, lens) else (mid, hi)
     return hi
 
 
@@ -123,18 +138,55 @@ def warp_frame(frame: NDArray[np.uint8], H: NDArray) -> NDArray[np.uint8]:
 
 
 def warp_frame_rolling(frame: NDArray[np.uint8], H: NDArray, rows: NDArray) -> NDArray[np.uint8]:
-    """Warp by row-dependent homographies H (B, 3, 3) at input knot rows (B,).
+    """Warp by row-dependent homographies H (B, 3, 3) at input knot rows (B,)."""
+    Hinv = inverses(H)
 
-    The source coordinates are computed exactly on a grid every ``MAP_STEP`` output
-    pixels, corners included, and interpolated bilinearly in between (the map is smooth:
-    about 0.01 px off), then ``cv2.remap`` samples the frame.
+    def source(pts: NDArray) -> NDArray:
+        src = back_project(Hinv, rows, pts)
+        z = np.where(src[:, 2] > 1e-9, src[:, 2], np.nan)
+        return src[:, :2] / z[:, None]
+
+    return remap_from(frame, source)
+
+
+def lens_source(
+    lens: Lens, C: NDArray, zoom: float, pts: NDArray, rows: NDArray | None = None
+) -> NDArray[np.float64]:
+    """Input pixels (M, 2) of output pixels under a lens: unproject with the zoomed lens,
+    turn by Cᵀ, project with the lens. ``C`` per knot row (B, 3, 3) with ``rows``: the
+    source row is found by the same fixed-point iteration as for homographies."""
+    rays = unproject(lens.zoomed(zoom), pts)
+    if rows is None:
+        return project(lens, rays @ C)
+    src = project(lens, rays @ C[len(rows) // 2])
+    for _ in range(ROW_ITERATIONS):
+        y = np.clip(np.nan_to_num(src[:, 1], nan=rows[0]), rows[0], rows[-1])
+        k = np.clip(np.searchsorted(rows, y) - 1, 0, len(rows) - 2)
+        frac = ((y - rows[k]) / (rows[k + 1] - rows[k]))[:, None, None]
+        Ck = C[k] + frac * (C[k + 1] - C[k])  # turns between knots are tiny: lerp is exact enough
+        src = project(lens, np.einsum("mj,mji->mi", rays, Ck))
+    return src
+
+
+def warp_frame_lens(
+    frame: NDArray[np.uint8], lens: Lens, C: NDArray, zoom: float, rows: NDArray | None = None
+) -> NDArray[np.uint8]:
+    """Undistort → rotate → redistort in one remap (see :mod:`stabilize.lens`)."""
+    return remap_from(frame, lambda pts: lens_source(lens, C, zoom, pts, rows))
+
+
+def remap_from(frame: NDArray[np.uint8], source) -> NDArray[np.uint8]:
+    """Warp a frame by any smooth map ``source``: output pixels (M, 2) → input pixels.
+
+    The map is computed exactly on a grid every ``MAP_STEP`` output pixels, corners
+    included, and interpolated bilinearly in between (about 0.01 px off); NaN marks
+    pixels with no source. ``cv2.remap`` then samples the frame.
     """
     h, w = frame.shape[:2]
     (xs, Wx), (ys, Wy) = _knots(w), _knots(h)
     gx, gy = np.meshgrid(xs, ys)
-    src = back_project(inverses(H), rows, np.c_[gx.ravel(), gy.ravel()])
-    z = np.where(src[:, 2] > 1e-9, src[:, 2], np.nan)
-    coarse = np.nan_to_num(src[:, :2] / z[:, None], nan=-1e4).reshape(*gx.shape, 2)
+    coarse = np.nan_to_num(source(np.c_[gx.ravel(), gy.ravel()]), nan=-1e4)
+    coarse = coarse.reshape(*gx.shape, 2)
     # Bilinear upsampling as two small matrix products, in float: cv2.resize cannot keep
     # the corners aligned and cv2.remap would quantise the weights to 1/32 of a cell.
     maps = [Wy @ coarse[..., c].astype(np.float32) @ Wx.T for c in range(2)]
