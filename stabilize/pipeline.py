@@ -34,7 +34,7 @@ from stabilize.smoothing import (
 )
 from stabilize.track import VisualTrack, mean_row
 from stabilize.video_reader import VideoError, VideoInfo, frame_times, probe, read_frames
-from stabilize.video_writer import Encoding, FrameWriter
+from stabilize.video_writer import Encoding, FrameWriter, is_variable_rate, retime
 from stabilize.warping import (
     homography,
     required_zoom,
@@ -284,18 +284,32 @@ def render(
     settings: Settings,
     progress: Progress = _no_progress,
 ) -> int:
-    """Pass 2: decode, warp, encode with the audio copied; returns frames written."""
+    """Pass 2: decode, warp, encode with the audio copied; returns frames written.
+
+    A variable-frame-rate clip is encoded at its nominal rate without B-frames, then its
+    packets are restamped with the source's own frame times (:func:`retime`).
+    """
     audio = ffmpeg.input(str(path)).audio if info.has_audio else None
     written = 0
     fps = info.fps or 30.0
     h, w = info.size
     size = (h, 2 * w) if settings.preview else (h, w)
-    with FrameWriter(out, size, fps, settings.encoding, audio, copy_audio=True) as writer:
-        for k, frame in zip(range(len(planned.zoom)), read_frames(path, info=info), strict=False):
-            warped = planned.warp(k, frame)
-            writer.write(np.hstack([frame, warped]) if settings.preview else warped)
-            written += 1
-            progress(1)
+    variable = is_variable_rate(planned.times)
+    encoding = replace(settings.encoding, b_frames=False) if variable else settings.encoding
+    target = out.with_name(out.name + ".cfr.mp4") if variable else out
+    try:
+        with FrameWriter(target, size, fps, encoding, audio, copy_audio=True) as writer:
+            frames = read_frames(path, info=info)
+            for k, frame in zip(range(len(planned.zoom)), frames, strict=False):
+                warped = planned.warp(k, frame)
+                writer.write(np.hstack([frame, warped]) if settings.preview else warped)
+                written += 1
+                progress(1)
+        if variable:
+            retime(target, out, planned.times[:written])
+    finally:
+        if variable:
+            target.unlink(missing_ok=True)
     return written
 
 

@@ -45,6 +45,34 @@ def test_frames_timestamps_and_audio_are_kept(shaky, stabilised):
     assert summary["frames"] == len(frame_times(shaky)) == 60
 
 
+def test_variable_frame_rate_timestamps_are_kept(shaky, tmp_path):
+    vfr = tmp_path / "vfr.mp4"
+    jitter = ["-vf", "setpts=(N+0.4*mod(N\\,3))/30/TB", "-enc_time_base:v", "1:90000"]
+    subprocess.run(
+        [
+            ffmpeg_exe(),
+            "-v",
+            "error",
+            "-i",
+            str(shaky),
+            *jitter,
+            "-fps_mode",
+            "passthrough",
+            "-c:a",
+            "copy",
+            str(vfr),
+        ],
+        check=True,
+    )
+    times = frame_times(vfr)
+    assert len(times) == 60 and np.ptp(np.diff(times)) > 0.01  # really variable
+    out = tmp_path / "out.mp4"
+    summary, _ = stabilize_video(vfr, out, Settings(fov=70.0))
+    np.testing.assert_allclose(frame_times(out), times, atol=1e-3)
+    assert summary["frames"] == 60 and probe(out).has_audio
+    assert not list(tmp_path.glob("*.cfr.mp4"))  # the intermediate file is gone
+
+
 def test_no_black_border_in_auto_crop(stabilised):
     out, _, _ = stabilised
     for frame in read_frames(out):
