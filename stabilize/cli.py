@@ -209,12 +209,17 @@ def _settings(flow_name: str, raft_weights: Path | None, device: str, **options)
     """Settings for the pipeline; options are Settings fields (fov, smooth, crop, ...)."""
     from stabilize.pipeline import Settings
 
+    if device not in ("cpu", "cuda"):
+        _fail(f"--device must be cpu or cuda, got {device!r}")
+    if device == "cuda":
+        import torch
+
+        if not torch.cuda.is_available():
+            _fail("--device cuda was asked for, but torch sees no CUDA device")
     flow_options = {}
     if flow_name.startswith("raft"):
         flow_options = {"weights": raft_weights, "device": device}
-    elif device == "cuda":
-        _fail("--device cuda needs a RAFT flow backend (--flow raft)")
-    return Settings(flow=flow_name, flow_options=flow_options, **options)
+    return Settings(flow=flow_name, flow_options=flow_options, device=device, **options)
 
 
 FOCAL_ROUNDS = 3  # re-estimations when fitting the focal length to the gyro
@@ -238,7 +243,7 @@ def run(
     output_path: Path = typer.Argument(..., metavar="OUT", help="Where to write the result."),
     flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
     raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
-    device: str = typer.Option("cpu", help="cpu or cuda (for RAFT)."),
+    device: str = typer.Option("cpu", help="cpu or cuda: RAFT flow and the frame warps."),
     fov: float | None = typer.Option(
         None, help="Horizontal field of view, deg (default 69: a phone's main camera)."
     ),
@@ -349,7 +354,7 @@ def rotations(
     ),
     flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
     raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
-    device: str = typer.Option("cpu", help="cpu or cuda (for RAFT)."),
+    device: str = typer.Option("cpu", help="cpu or cuda: RAFT flow and the frame warps."),
     fov: float | None = typer.Option(None, help="Horizontal field of view, deg (default 69)."),
     focal: float | None = typer.Option(None, help="Focal length in pixels (overrides --fov)."),
     overwrite: bool = typer.Option(False, help="Replace the output if it exists."),

@@ -12,8 +12,9 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import asdict, dataclass, field, replace
+from itertools import islice
 from pathlib import Path
 
 import cv2
@@ -41,12 +42,14 @@ from stabilize.warping import (
     warp_frame,
     warp_frame_lens,
     warp_frame_rolling,
+    warp_frames_torch,
 )
 
 # A phone's main camera is about 26 mm full-frame equivalent: 69° across the long side.
 DEFAULT_HFOV = 69.0
 CROP_MODES = ("auto", "dynamic", "none")
 ESTIMATE_CHUNK = 32  # flow fields held at once in pass 1
+WARP_BATCH = 8  # frames warped together on CUDA
 READOUT_BANDS = 6  # horizontal bands whose rotations date the rows (readout estimation)
 
 
@@ -70,6 +73,7 @@ class Settings:
     readout_ms: float | str | None = None  # rolling shutter: ms, 'auto', or the log's value
     gyro_drift: bool = False  # also fit a linear clock drift
     lens: str | None = None  # a Gyroflow lens profile (OpenCV fisheye)
+    device: str = "cpu"  # where frames are warped: cpu (OpenCV) or cuda (kornia, batched)
     encoding: Encoding = field(default_factory=Encoding)
 
     def focal_px(self, width: int) -> float:
@@ -95,6 +99,18 @@ class CameraPath:
     knot_rows: NDArray | None = None
     row_corrections: NDArray | None = None  # (N, B, 3, 3)
     lens: Lens | None = None  # fisheye: frames are warped through it, not by homographies
+
+    def warp_many(
+        self, batch: Sequence[tuple[int, NDArray[np.uint8]]], device: str = "cpu"
+    ) -> list[NDArray[np.uint8]]:
+        """Output frames of (k, frame) pairs; on CUDA the plain homography warps run as one
+        batch (lens and rolling-shutter maps stay on the CPU)."""
+        plain = self.lens is None and self.row_homographies is None
+        if not (device.startswith("cuda") and plain):
+            return [self.warp(k, frame) for k, frame in batch]
+        ks = [k for k, _ in batch]
+        frames = np.stack([frame for _, frame in batch])
+        return list(warp_frames_torch(frames, self.homographies[ks], device))
 
     def warp(self, k: int, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
         """Frame k of the output."""
@@ -299,18 +315,27 @@ def render(
     target = out.with_name(out.name + ".cfr.mp4") if variable else out
     try:
         with FrameWriter(target, size, fps, encoding, audio, copy_audio=True) as writer:
-            frames = read_frames(path, info=info)
-            for k, frame in zip(range(len(planned.zoom)), frames, strict=False):
-                warped = planned.warp(k, frame)
-                writer.write(np.hstack([frame, warped]) if settings.preview else warped)
-                written += 1
-                progress(1)
+            frames = zip(range(len(planned.zoom)), read_frames(path, info=info), strict=False)
+            for batch in batches(frames, WARP_BATCH if settings.device == "cuda" else 1):
+                for frame, warped in zip(
+                    (f for _, f in batch), planned.warp_many(batch, settings.device), strict=True
+                ):
+                    writer.write(np.hstack([frame, warped]) if settings.preview else warped)
+                    written += 1
+                    progress(1)
         if variable:
             retime(target, out, planned.times[:written])
     finally:
         if variable:
             target.unlink(missing_ok=True)
     return written
+
+
+def batches(items: Iterable, n: int) -> Iterator[list]:
+    """Consecutive lists of n items (the last may be shorter)."""
+    it = iter(items)
+    while batch := list(islice(it, n)):
+        yield batch
 
 
 def _from_gyro(

@@ -206,3 +206,24 @@ def _knots(n: int) -> tuple[NDArray, NDArray]:
     weights[np.arange(n), before] = 1.0 - frac
     weights[np.arange(n), before + 1] = frac
     return knots, weights
+
+
+def warp_frames_torch(
+    frames: NDArray[np.uint8], H: NDArray, device: str = "cuda"
+) -> NDArray[np.uint8]:
+    """Warp a batch (B, H, W, 3) by homographies (B, 3, 3) with kornia on ``device``.
+
+    The same mapping as :func:`warp_frame` (pixel centres at integers, bilinear, black
+    outside), for CUDA, where one batched call beats a frame at a time. On the CPU,
+    OpenCV is about 20× faster than this.
+    """
+    import kornia
+    import torch
+
+    src = torch.from_numpy(np.ascontiguousarray(frames)).to(device)
+    src = src.permute(0, 3, 1, 2).float()
+    M = torch.as_tensor(np.asarray(H), dtype=torch.float32, device=device)
+    h, w = frames.shape[1:3]
+    out = kornia.geometry.transform.warp_perspective(src, M, (h, w), align_corners=True)
+    out = out.round_().clamp_(0, 255).to(torch.uint8).permute(0, 2, 3, 1)
+    return out.cpu().numpy()
