@@ -16,7 +16,7 @@ import multiprocessing as mp
 import os
 import time
 from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -25,6 +25,7 @@ from stabilize.ffmpeg_tools import atomic_output
 MANIFEST = "manifest.json"
 GYRO_SIDECARS = (".gcsv", ".csv", ".txt")
 BYTES_PER_WORKER = 1.5 * 2**30  # the pipeline's peak at 1080p, with headroom
+FRAME_REPORT = 10  # frames a worker counts before it reports them
 THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")
 
 
@@ -112,8 +113,14 @@ def is_complete(job: Job, row: dict | None) -> bool:
     )
 
 
-def _limit_threads(threads: int) -> None:
-    """Bound each worker's threads (numba, BLAS, OpenCV), so N workers share the cores."""
+_FRAMES = None  # a worker's queue for frame counts, set by _start_worker
+
+
+def _start_worker(threads: int, frames) -> None:
+    """Bound each worker's threads (numba, BLAS, OpenCV), so N workers share the cores,
+    and keep the queue that frame counts go back on."""
+    global _FRAMES
+    _FRAMES = frames
     for var in THREAD_VARS:
         os.environ[var] = str(threads)
     import cv2
@@ -121,16 +128,41 @@ def _limit_threads(threads: int) -> None:
     cv2.setNumThreads(threads)
 
 
-def run_job(job: Job, settings) -> dict:
-    """Stabilise one file; never raises: a failure is a row with its error."""
+def _report_frames(n: int) -> None:
+    if _FRAMES is not None:
+        _FRAMES.put(n)
+
+
+def run_job(job: Job, settings, on_frames: Callable[[int], None] | None = None) -> dict:
+    """Stabilise one file; never raises: a failure is a row with its error.
+
+    ``on_frames(n)`` hears of every n frames written (a worker reports on its queue).
+    """
     from stabilize.pipeline import stabilize_video
+
+    on_frames = on_frames or _report_frames
+    counted = [0]
+
+    def stage(label: str, _total: int | None):
+        if label != "stabilising":
+            return lambda n=1: None
+
+        def advance(n: int = 1) -> None:  # batched: one message per FRAME_REPORT frames
+            counted[0] += n
+            if counted[0] >= FRAME_REPORT:
+                on_frames(counted[0])
+                counted[0] = 0
+
+        return advance
 
     start = time.perf_counter()
     row = {"input": job.input, "output": job.output, "size": job.size, "mtime": job.mtime}
     try:
         if job.gyro:
             settings = replace(settings, gyro=job.gyro)
-        summary, _ = stabilize_video(job.source, job.output, settings, overwrite=True)
+        summary, _ = stabilize_video(
+            job.source, job.output, settings, overwrite=True, progress=stage
+        )
         row.update(
             status="done",
             error="",
@@ -141,6 +173,8 @@ def run_job(job: Job, settings) -> dict:
     except Exception as err:  # isolate every failure: one bad file must not stop the rest
         message = str(err).splitlines()[0] if str(err) else type(err).__name__
         row.update(status="failed", error=message)
+    if counted[0]:
+        on_frames(counted[0])
     row["seconds"] = round(time.perf_counter() - start, 3)
     return row
 
@@ -162,8 +196,12 @@ def run_batch(
     workers: int | None = None,
     on_done: Callable[[dict], None] | None = None,
     ray_address: str | None = None,
+    on_frames: Callable[[int], None] | None = None,
 ) -> list[dict]:
     """Run the jobs not already complete; returns every job's row, in input order.
+
+    ``on_done(row)`` hears of every file as it finishes, ``on_frames(n)`` of frames
+    written (local workers; Ray tasks report files only).
 
     With ``ray_address`` (an address, or ``auto`` for the running cluster) the jobs run
     as Ray tasks instead of local processes; the manifest and resume work the same.
@@ -186,7 +224,7 @@ def run_batch(
     rows_in = (
         _execute_ray(todo, settings, ray_address)
         if ray_address
-        else _execute(todo, settings, workers or default_workers())
+        else _execute(todo, settings, workers or default_workers(), on_frames)
     )
     for row in rows_in:
         rows[row["input"]] = row
@@ -196,20 +234,30 @@ def run_batch(
     return [rows[job.input] for job in jobs]
 
 
-def _execute(jobs: list[Job], settings, workers: int) -> Iterator[dict]:
+def _execute(
+    jobs: list[Job], settings, workers: int, on_frames: Callable[[int], None] | None
+) -> Iterator[dict]:
+    on_frames = on_frames or (lambda n: None)
     if workers <= 1 or len(jobs) <= 1:
         for job in jobs:
-            yield run_job(job, settings)
+            yield run_job(job, settings, on_frames)
         return
     threads = max(1, (os.cpu_count() or 1) // workers)
     settings = replace(settings, encoding=replace(settings.encoding, threads=threads))
     context = mp.get_context("spawn")  # clean workers: no inherited threads or locks
+    frames = context.SimpleQueue()
     with ProcessPoolExecutor(
-        workers, mp_context=context, initializer=_limit_threads, initargs=(threads,)
+        workers, mp_context=context, initializer=_start_worker, initargs=(threads, frames)
     ) as pool:
-        futures = [pool.submit(run_job, job, settings) for job in jobs]
-        for future in as_completed(futures):
-            yield future.result()
+        pending = {pool.submit(run_job, job, settings) for job in jobs}
+        while pending:
+            finished, pending = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
+            while not frames.empty():
+                on_frames(frames.get())
+            for future in finished:
+                yield future.result()
+        while not frames.empty():
+            on_frames(frames.get())
 
 
 def _execute_ray(jobs: list[Job], settings, address: str) -> Iterator[dict]:

@@ -581,7 +581,7 @@ def batch(
     from rich.table import Table
 
     from stabilize.batch import find_jobs, run_batch
-    from stabilize.progress import progress_bar
+    from stabilize.progress import batch_progress
     from stabilize.video_writer import Encoding
 
     if not in_dir.is_dir():
@@ -604,15 +604,17 @@ def batch(
     if not jobs:
         _fail(f"{in_dir}: no files match {pattern!r}")
     console = Console(stderr=True)
-    with progress_bar("files", len(jobs), unit="files", quiet=quiet) as advance:
+    with batch_progress(len(jobs), quiet=quiet) as (file_done, frames_done):
 
         def done(row: dict) -> None:
-            advance(1)
+            file_done()
             if not quiet:
                 console.print(f"{row['status']:8s} {row['input']}  {row.get('error', '')}")
 
         try:
-            rows = run_batch(jobs, out_dir, settings, workers, done, ray_address=ray)
+            rows = run_batch(
+                jobs, out_dir, settings, workers, done, ray_address=ray, on_frames=frames_done
+            )
         except (RuntimeError, ConnectionError) as err:
             _fail(str(err).splitlines()[0])
     table = Table(title=f"{len(rows)} files → {out_dir}")

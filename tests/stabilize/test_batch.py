@@ -113,3 +113,15 @@ def test_a_killed_run_leaves_nothing_unfinished_under_a_final_name(folder, tmp_p
 def test_batch_errors():
     result = CliRunner().invoke(app, ["batch", "no-such-folder", "out"])
     assert result.exit_code != 0 and "not a folder" in result.output
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_frames_written_are_reported_from_every_worker(folder, tmp_path, workers):
+    from stabilize.batch import run_batch
+    from stabilize.pipeline import Settings
+
+    jobs = [j for j in find_jobs(folder, tmp_path / "out", "*", True) if "corrupt" not in j.input]
+    jobs = [j for j in jobs if j.input.endswith(".mp4")]
+    frames, files = [], []
+    run_batch(jobs, tmp_path / "out", Settings(), workers, files.append, on_frames=frames.append)
+    assert len(files) == 2 and sum(frames) == 2 * 90
