@@ -6,6 +6,7 @@ python bench/batch_bench.py            # 4 clips of 3 s at 640×360
 from __future__ import annotations
 
 import argparse
+import json
 import subprocess
 import sys
 import tempfile
@@ -45,7 +46,12 @@ def main() -> None:
             check=True,
         )
         times[workers] = time.perf_counter() - t0
-        print(f"{workers} worker(s): {times[workers]:.1f} s for {args.clips} clips")
+        rows = json.loads((out / "manifest.json").read_text())
+        peak = max(row.get("peak_mb", 0.0) for row in rows)
+        print(
+            f"{workers} worker(s): {times[workers]:.1f} s for {args.clips} clips, "
+            f"peak memory per worker {peak:.0f} MB"
+        )
     print(f"speedup with 2 workers: {times[1] / times[2]:.2f}×")
 
 

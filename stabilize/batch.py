@@ -94,7 +94,17 @@ def write_manifest(out_dir: Path, rows: dict[str, dict]) -> None:
     ordered = [rows[k] for k in sorted(rows)]
     with atomic_output(out_dir / MANIFEST, overwrite=True) as tmp:
         tmp.write_text(json.dumps(ordered, indent=2))
-    fields = ["input", "status", "seconds", "output", "error", "mean_support", "zoom", "frames"]
+    fields = [
+        "input",
+        "status",
+        "seconds",
+        "output",
+        "error",
+        "mean_support",
+        "zoom",
+        "frames",
+        "peak_mb",
+    ]
     with atomic_output(out_dir / "manifest.csv", overwrite=True) as tmp:
         with open(tmp, "w", newline="") as f:
             writer = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
@@ -176,7 +186,18 @@ def run_job(job: Job, settings, on_frames: Callable[[int], None] | None = None) 
     if counted[0]:
         on_frames(counted[0])
     row["seconds"] = round(time.perf_counter() - start, 3)
+    row["peak_mb"] = peak_memory_mb()
     return row
+
+
+def peak_memory_mb() -> float:
+    """Peak resident memory so far of this process and of its largest finished child
+    (FFmpeg), MB: what one worker needs."""
+    import resource
+
+    own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    child = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    return round(max(own, child) / 1024.0, 1)  # Linux reports KiB
 
 
 def default_workers() -> int:

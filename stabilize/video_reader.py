@@ -98,9 +98,13 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
 
 
 def read_frames(
-    path: str | Path, size: tuple[int, int] | None = None, info: VideoInfo | None = None
+    path: str | Path,
+    size: tuple[int, int] | None = None,
+    info: VideoInfo | None = None,
+    pix_fmt: str = "rgb24",
 ) -> Iterator[NDArray[np.uint8]]:
     """RGB uint8 frames (H, W, 3), streamed; resized to ``size`` (H, W) if given.
+    ``pix_fmt="yuv420p"`` gives I420 frames (3H/2, W) instead (:mod:`stabilize.yuv`).
 
     FFmpeg applies the display rotation, so frames come upright. A stream that ends
     early or breaks raises :class:`VideoError` after the frames that did decode.
@@ -112,17 +116,18 @@ def read_frames(
     if size is not None and size != info.size:
         stream = stream.filter("scale", w, h, flags="area")
     process = (
-        stream.output("pipe:", format="rawvideo", pix_fmt="rgb24", fps_mode="passthrough")
+        stream.output("pipe:", format="rawvideo", pix_fmt=pix_fmt, fps_mode="passthrough")
         .global_args("-hide_banner", "-loglevel", "error", "-nostdin")
         .run_async(cmd=ffmpeg_exe(), pipe_stdout=True, pipe_stderr=True)
     )
-    frame_bytes = h * w * 3
+    shape = (h * 3 // 2, w) if pix_fmt == "yuv420p" else (h, w, 3)
+    frame_bytes = int(np.prod(shape))
     try:
         while True:
             buf = process.stdout.read(frame_bytes)
             if len(buf) < frame_bytes:
                 break
-            yield np.frombuffer(buf, np.uint8).reshape(h, w, 3)
+            yield np.frombuffer(buf, np.uint8).reshape(shape)
     finally:
         process.stdout.close()
         err = process.stderr.read().decode(errors="replace").strip()

@@ -26,7 +26,8 @@ class Encoding:
 
 
 class FrameWriter:
-    """Streams RGB uint8 frames into an encoder process.
+    """Streams RGB uint8 frames (or I420, with ``pix_fmt_in="yuv420p"``) into an encoder
+    process.
 
     Constant frame rate ``fps``. An optional audio stream (ffmpeg-python) is muxed in:
     copied untouched (``copy_audio``, for a source file's audio) or encoded to AAC and
@@ -42,12 +43,13 @@ class FrameWriter:
         audio=None,
         *,
         copy_audio: bool = False,
+        pix_fmt_in: str = "rgb24",
     ) -> None:
         encoding = encoding or Encoding()
         h, w = size
-        self.size = size
+        self.shape = (h * 3 // 2, w) if pix_fmt_in == "yuv420p" else (h, w, 3)
         video = ffmpeg.input(
-            "pipe:", format="rawvideo", pix_fmt="rgb24", s=f"{w}x{h}", framerate=fps
+            "pipe:", format="rawvideo", pix_fmt=pix_fmt_in, s=f"{w}x{h}", framerate=fps
         )
         streams = [video] if audio is None else [video, audio]
         options = {
@@ -74,8 +76,8 @@ class FrameWriter:
         )
 
     def write(self, frame: NDArray[np.uint8]) -> None:
-        if frame.shape[:2] != self.size or frame.dtype != np.uint8:
-            raise ValueError(f"frame must be uint8 {self.size}, got {frame.dtype} {frame.shape}")
+        if frame.shape != self.shape or frame.dtype != np.uint8:
+            raise ValueError(f"frame must be uint8 {self.shape}, got {frame.dtype} {frame.shape}")
         self._process.stdin.write(np.ascontiguousarray(frame).tobytes())
 
     def close(self) -> None:

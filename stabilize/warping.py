@@ -139,6 +139,11 @@ def warp_frame(frame: NDArray[np.uint8], H: NDArray) -> NDArray[np.uint8]:
 
 def warp_frame_rolling(frame: NDArray[np.uint8], H: NDArray, rows: NDArray) -> NDArray[np.uint8]:
     """Warp by row-dependent homographies H (B, 3, 3) at input knot rows (B,)."""
+    return remap_from(frame, rolling_source(H, rows))
+
+
+def rolling_source(H: NDArray, rows: NDArray):
+    """The map output pixels (M, 2) → input pixels of row-dependent homographies."""
     Hinv = inverses(H)
 
     def source(pts: NDArray) -> NDArray:
@@ -146,7 +151,7 @@ def warp_frame_rolling(frame: NDArray[np.uint8], H: NDArray, rows: NDArray) -> N
         z = np.where(src[:, 2] > 1e-9, src[:, 2], np.nan)
         return src[:, :2] / z[:, None]
 
-    return remap_from(frame, source)
+    return source
 
 
 def lens_source(
@@ -175,7 +180,7 @@ def warp_frame_lens(
     return remap_from(frame, lambda pts: lens_source(lens, C, zoom, pts, rows))
 
 
-def remap_from(frame: NDArray[np.uint8], source) -> NDArray[np.uint8]:
+def remap_from(frame: NDArray[np.uint8], source, fill: int = 0) -> NDArray[np.uint8]:
     """Warp a frame by any smooth map ``source``: output pixels (M, 2) → input pixels.
 
     The map is computed exactly on a grid every ``MAP_STEP`` output pixels, corners
@@ -190,7 +195,9 @@ def remap_from(frame: NDArray[np.uint8], source) -> NDArray[np.uint8]:
     # Bilinear upsampling as two small matrix products, in float: cv2.resize cannot keep
     # the corners aligned and cv2.remap would quantise the weights to 1/32 of a cell.
     maps = [Wy @ coarse[..., c].astype(np.float32) @ Wx.T for c in range(2)]
-    return cv2.remap(frame, maps[0], maps[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
+    return cv2.remap(
+        frame, maps[0], maps[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=fill
+    )
 
 
 @functools.lru_cache(maxsize=8)
@@ -209,21 +216,25 @@ def _knots(n: int) -> tuple[NDArray, NDArray]:
 
 
 def warp_frames_torch(
-    frames: NDArray[np.uint8], H: NDArray, device: str = "cuda"
+    frames: NDArray[np.uint8], H: NDArray, device: str = "cuda", fill: int = 0
 ) -> NDArray[np.uint8]:
-    """Warp a batch (B, H, W, 3) by homographies (B, 3, 3) with kornia on ``device``.
+    """Warp a batch (B, H, W) or (B, H, W, C) by homographies (B, 3, 3) with kornia on
+    ``device``, ``fill`` outside.
 
-    The same mapping as :func:`warp_frame` (pixel centres at integers, bilinear, black
-    outside), for CUDA, where one batched call beats a frame at a time. On the CPU,
-    OpenCV is about 20× faster than this.
+    The same mapping as :func:`warp_frame` (pixel centres at integers, bilinear), for
+    CUDA, where one batched call beats a frame at a time. On the CPU, OpenCV is about 20×
+    faster than this.
     """
     import kornia
     import torch
 
+    planar = frames.ndim == 3
     src = torch.from_numpy(np.ascontiguousarray(frames)).to(device)
-    src = src.permute(0, 3, 1, 2).float()
+    src = (src[:, None] if planar else src.permute(0, 3, 1, 2)).float() - fill
     M = torch.as_tensor(np.asarray(H), dtype=torch.float32, device=device)
     h, w = frames.shape[1:3]
+    # Warping (x - fill) with zero padding, then adding fill back, pads with fill.
     out = kornia.geometry.transform.warp_perspective(src, M, (h, w), align_corners=True)
-    out = out.round_().clamp_(0, 255).to(torch.uint8).permute(0, 2, 3, 1)
+    out = (out + fill).round_().clamp_(0, 255).to(torch.uint8)
+    out = out[:, 0] if planar else out.permute(0, 2, 3, 1)
     return out.cpu().numpy()

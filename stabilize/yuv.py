@@ -1,0 +1,93 @@
+"""Frames as I420 (planar YUV 4:2:0), the layout H.264 stores.
+
+Pass 2 decodes, warps and encodes in I420 rather than RGB: FFmpeg then converts no colours
+on either side, half as many bytes cross the pipes, and a warp touches 1.5 bytes per
+pixel instead of 3. A frame is one (3H/2, W) uint8 array: the luma plane (H, W), then the
+two chroma planes (H/2, W/2) one after the other. Both sides must be even.
+
+A chroma plane is the luma plane at half size, with pixel centres at integers in both
+(CONVENTIONS.md), so full-size x is 2x' + ½ at half size x', and a full-size homography
+H acts on chroma as S H S⁻¹ with S: x' = (x + ½)/2 - ½.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+BLACK = (16, 128, 128)  # limited-range black: Y, U, V
+HALF = np.array([[0.5, 0.0, -0.25], [0.0, 0.5, -0.25], [0.0, 0.0, 1.0]])  # S above
+
+
+def supports(size: tuple[int, int]) -> bool:
+    """Whether an (H, W) frame can travel as I420 (both sides even)."""
+    return size[0] % 2 == 0 and size[1] % 2 == 0
+
+
+def split(frame: NDArray[np.uint8]) -> tuple[NDArray, NDArray, NDArray]:
+    """(Y, U, V) views of an I420 frame (3H/2, W)."""
+    h = frame.shape[0] * 2 // 3
+    w = frame.shape[1]
+    chroma = frame[h:].reshape(2, h // 2, w // 2)
+    return frame[:h], chroma[0], chroma[1]
+
+
+def join(y: NDArray, u: NDArray, v: NDArray) -> NDArray[np.uint8]:
+    h, w = y.shape
+    return np.concatenate([y, np.stack([u, v]).reshape(h // 2, w)])
+
+
+def chroma_homography(H: NDArray) -> NDArray[np.float64]:
+    """The full-size homography H acting on the half-size chroma planes: S H S⁻¹."""
+    return HALF @ np.asarray(H) @ np.linalg.inv(HALF)
+
+
+def warp(frame: NDArray[np.uint8], H: NDArray) -> NDArray[np.uint8]:
+    """cv2.warpPerspective of every plane by H (chroma by S H S⁻¹); black outside."""
+    y, u, v = split(frame)
+    Hc = chroma_homography(H)
+
+    def one(plane: NDArray, M: NDArray, fill: int) -> NDArray:
+        size = (plane.shape[1], plane.shape[0])
+        return cv2.warpPerspective(plane, M, size, flags=cv2.INTER_LINEAR, borderValue=fill)
+
+    return join(one(y, H, BLACK[0]), one(u, Hc, BLACK[1]), one(v, Hc, BLACK[2]))
+
+
+def remap(
+    frame: NDArray[np.uint8],
+    source: Callable[[NDArray], NDArray],
+    remap_plane: Callable[[NDArray, Callable[[NDArray], NDArray], int], NDArray],
+) -> NDArray[np.uint8]:
+    """Warp every plane by a map ``source`` (full-size output pixels → input pixels).
+
+    ``remap_plane(plane, source, fill)`` warps one plane; chroma sees the same map
+    through the half-size coordinates.
+    """
+    y, u, v = split(frame)
+
+    def chroma_source(pts: NDArray) -> NDArray:
+        return (source(2.0 * pts + 0.5) + 0.5) / 2.0 - 0.5
+
+    return join(
+        remap_plane(y, source, BLACK[0]),
+        remap_plane(u, chroma_source, BLACK[1]),
+        remap_plane(v, chroma_source, BLACK[2]),
+    )
+
+
+def hstack(a: NDArray[np.uint8], b: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """Two I420 frames side by side."""
+    return join(*(np.hstack([p, q]) for p, q in zip(split(a), split(b), strict=True)))
+
+
+def from_rgb(rgb: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """RGB (H, W, 3) → I420 (limited range, BT.601), for tests and synthetic frames."""
+    return cv2.cvtColor(rgb, cv2.COLOR_RGB2YUV_I420)
+
+
+def to_rgb(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    return cv2.cvtColor(frame, cv2.COLOR_YUV2RGB_I420)
