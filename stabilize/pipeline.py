@@ -42,6 +42,7 @@ from stabilize.warping import (
     lens_source,
     remap_from,
     required_zoom,
+    required_zooms,
     rolling_source,
     warp_frame,
     warp_frames_torch,
@@ -277,9 +278,10 @@ def plan(
         return C if rolling is None else C[:, None] @ np.swapaxes(rolling.turns, -1, -2)
 
     def zoom_of(path: NDArray) -> NDArray:
-        return np.array(
-            [required_zoom(K, c, size, settings.max_zoom * 1.001, rows) for c in corrections(path)]
-        )
+        limit = settings.max_zoom * 1.001
+        if rolling is None and lens is None:
+            return required_zooms(K, corrections(path), size, limit)
+        return np.array([required_zoom(K, c, size, limit, rows, lens) for c in corrections(path)])
 
     if settings.crop == "none":
         need = np.ones(len(O))

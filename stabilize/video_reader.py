@@ -111,9 +111,14 @@ def read_frames(
     """
     info = info or probe(path)
     h, w = size or info.size
-    options = dict(zip(info.input_args[::2], info.input_args[1::2], strict=True))
-    stream = ffmpeg.input(str(path), **{k.lstrip("-"): v for k, v in options.items()})
-    if size is not None and size != info.size:
+    options = {k.lstrip("-"): v for k, v in zip(*[iter(info.input_args)] * 2, strict=True)}
+    shrink = size is not None and size != info.size
+    if shrink:
+        # Deblocking only smooths detail that the downscale averages away anyway; skipping
+        # it makes the decode about 20% faster.
+        options["skip_loop_filter"] = "all"
+    stream = ffmpeg.input(str(path), **options)
+    if shrink:
         stream = stream.filter("scale", w, h, flags="area")
     process = (
         stream.output("pipe:", format="rawvideo", pix_fmt=pix_fmt, fps_mode="passthrough")

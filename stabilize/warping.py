@@ -129,6 +129,40 @@ def required_zoom(
     return hi
 
 
+def required_zooms(
+    K: NDArray, C: NDArray, size: tuple[int, int], max_zoom: float = 4.0
+) -> NDArray[np.float64]:
+    """:func:`required_zoom` of many corrections (N, 3, 3) at once (pinhole, global
+    shutter): the same bisection, run on all frames together."""
+    C = np.asarray(C, dtype=np.float64)
+    h, w = size
+    pts = np.c_[_border(size), np.ones(4 * BORDER_SAMPLES)]
+
+    def covered(zoom: NDArray) -> NDArray[np.bool_]:
+        Z = np.zeros((len(C), 3, 3))
+        Z[:, 0, 0] = Z[:, 1, 1] = zoom
+        Z[:, 0, 2], Z[:, 1, 2], Z[:, 2, 2] = K[0, 2], K[1, 2], 1.0
+        Z[:, 0, 0] *= K[0, 0]
+        Z[:, 1, 1] *= K[1, 1]
+        Hinv = np.linalg.inv(Z @ C @ np.linalg.inv(K))
+        q = pts @ np.swapaxes(Hinv, -1, -2)  # (N, M, 3)
+        ok = (q[..., 2] > 0).all(axis=1)
+        z = np.where(q[..., 2] > 0, q[..., 2], 1.0)
+        x, y = q[..., 0] / z, q[..., 1] / z
+        inside = (x >= -0.5) & (x <= w - 0.5) & (y >= -0.5) & (y <= h - 0.5)
+        return ok & inside.all(axis=1)
+
+    lo, hi = np.ones(len(C)), np.full(len(C), float(max_zoom))
+    done = covered(lo)
+    hopeless = ~covered(hi) & ~done
+    for _ in range(30):
+        mid = 0.5 * (lo + hi)
+        fits = covered(mid)
+        hi = np.where(fits, mid, hi)
+        lo = np.where(fits, lo, mid)
+    return np.where(done, 1.0, np.where(hopeless, np.inf, hi))
+
+
 def warp_frame(frame: NDArray[np.uint8], H: NDArray) -> NDArray[np.uint8]:
     """cv2.warpPerspective (about 10 ms per 1080p frame on this CPU), black outside."""
     h, w = frame.shape[:2]

@@ -15,7 +15,7 @@ from stabilize.pipeline import Settings, estimate_rotations, stabilize_video
 from stabilize.rotation_files import read_rotations
 from stabilize.video_reader import probe, read_frames
 from stabilize.video_writer import FrameWriter
-from stabilize.warping import homography, warp_frame, warp_frame_lens
+from stabilize.warping import covers, homography, warp_frame, warp_frame_lens
 
 SAMPLE = Path(__file__).resolve().parents[2] / "samples" / "street"
 COEFFS = [0.03, -0.01, 0.004, -0.001]
@@ -154,5 +154,11 @@ def test_stabilising_a_fisheye_clip_with_its_lens_profile(fisheye_clip, tmp_path
     summary, planned = stabilize_video(clip, out, Settings(lens=str(lens_path)))
     assert summary["frames"] == 90 and out.is_file()
     assert planned.lens is not None and 1.0 < summary["zoom"] <= 1.5
+    # The zoom is found through the lens: every frame's border stays inside the input.
+    size = probe(clip).size
+    for C, zoom in zip(
+        planned.smooth @ np.swapaxes(planned.raw, -1, -2), planned.zoom, strict=True
+    ):
+        assert covers(planned.K, C, zoom, size, lens=planned.lens)
     means = [frame.mean() for frame in read_frames(out)]
     assert len(means) == 90 and min(means) > 20  # warped content, not black
