@@ -49,3 +49,17 @@ def atomic_output(path: str | os.PathLike, *, overwrite: bool = False) -> Iterat
         os.replace(tmp_path, final)
     finally:
         tmp_path.unlink(missing_ok=True)
+
+
+PIPE_BYTES = 1 << 20  # Linux's default ceiling for an unprivileged pipe
+
+
+def widen_pipe(stream) -> None:
+    """Grow a pipe to 1 MiB (from 64 KiB), so a raw frame crosses in a few large writes
+    instead of dozens of small ones; silently left alone where the OS does not allow it."""
+    try:
+        import fcntl
+
+        fcntl.fcntl(stream.fileno(), getattr(fcntl, "F_SETPIPE_SZ", 1031), PIPE_BYTES)
+    except (ImportError, OSError, ValueError):
+        pass

@@ -16,7 +16,7 @@ import ffmpeg
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.ffmpeg_tools import ffmpeg_exe
+from stabilize.ffmpeg_tools import ffmpeg_exe, widen_pipe
 
 
 class VideoError(ValueError):
@@ -125,6 +125,7 @@ def read_frames(
         .global_args("-hide_banner", "-loglevel", "error", "-nostdin")
         .run_async(cmd=ffmpeg_exe(), pipe_stdout=True, pipe_stderr=True)
     )
+    widen_pipe(process.stdout)
     shape = (h * 3 // 2, w) if pix_fmt == "yuv420p" else (h, w, 3)
     frame_bytes = int(np.prod(shape))
     try:

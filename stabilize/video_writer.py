@@ -10,7 +10,7 @@ import ffmpeg
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.ffmpeg_tools import ffmpeg_exe
+from stabilize.ffmpeg_tools import ffmpeg_exe, widen_pipe
 
 TIMESCALE = 90_000  # ticks per second of retimed video (MPEG's clock)
 
@@ -74,6 +74,7 @@ class FrameWriter:
             .overwrite_output()
             .run_async(cmd=ffmpeg_exe(), pipe_stdin=True, pipe_stderr=True)
         )
+        widen_pipe(self._process.stdin)
 
     def write(self, frame: NDArray[np.uint8]) -> None:
         if frame.shape != self.shape or frame.dtype != np.uint8:
