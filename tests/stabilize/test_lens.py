@@ -153,7 +153,7 @@ def test_stabilising_a_fisheye_clip_with_its_lens_profile(fisheye_clip, tmp_path
     out = tmp_path / "steady.mp4"
     summary, planned = stabilize_video(clip, out, Settings(lens=str(lens_path)))
     assert summary["frames"] == 90 and out.is_file()
-    assert planned.lens is not None and 1.0 < summary["zoom"] <= 1.5
+    assert planned.lens is not None and 1.0 < summary["zoom"] <= 1.15 + 1e-6
     # The zoom is found through the lens: every frame's border stays inside the input.
     size = probe(clip).size
     for C, zoom in zip(
