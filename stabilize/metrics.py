@@ -10,8 +10,9 @@
   separately and as the minimum of the two.
 * **ITF**: the mean PSNR of consecutive frames, in dB.
 
-Registrations are ORB features matched with a ratio test, then a RANSAC homography;
-frames with too few features fall back to the identity (and are counted).
+Registrations are ORB features, spread evenly over a grid, matched with a ratio test,
+then a RANSAC homography; frames with too few features fall back to the identity (and are
+counted).
 """
 
 from __future__ import annotations
@@ -24,6 +25,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 MIN_MATCHES = 12
+FEATURES = 2000  # ORB features per frame for registration
+GRID = (6, 8)  # cells they are spread over
 LOW_BAND = slice(1, 6)  # the 2nd to the 6th FFT components (index 0 is DC)
 REGISTRATION_LONG_SIDE = 640
 
@@ -40,14 +43,15 @@ class Registrar:
     """Homographies between frames (ORB + ratio test + RANSAC), in the frames' pixels."""
 
     def __init__(self) -> None:
-        self.orb = cv2.ORB_create(nfeatures=2000, fastThreshold=10)
+        self.orb = cv2.ORB_create(nfeatures=4 * FEATURES, fastThreshold=10)
         self.matcher = cv2.BFMatcher(cv2.NORM_HAMMING)
         self.failures = 0
 
     def features(self, frame: NDArray[np.uint8]):
         grey = _grey(frame)
         scale = frame.shape[1] / grey.shape[1]
-        kp, desc = self.orb.detectAndCompute(grey, None)
+        kp = spread(self.orb.detect(grey, None), grey.shape)
+        kp, desc = self.orb.compute(grey, kp)
         pts = np.float32([k.pt for k in kp]) * scale if kp else np.zeros((0, 2), np.float32)
         return pts, desc
 
@@ -69,6 +73,26 @@ class Registrar:
             self.failures += 1
             return np.eye(3)
         return H / H[2, 2]
+
+
+def spread(keypoints, shape: tuple[int, int], grid: tuple[int, int] = GRID) -> list:
+    """The strongest keypoints of each cell of a grid, FEATURES in all.
+
+    Left to itself ORB puts most of its features on the most textured thing in view,
+    often a close moving subject; RANSAC then registers that subject instead of the
+    scene. Spread over the frame, the features let the scene's motion win by area.
+    """
+    h, w = shape
+    rows, cols = grid
+    cells: dict[tuple[int, int], list] = {}
+    for k in keypoints:
+        key = (min(int(k.pt[1] * rows / h), rows - 1), min(int(k.pt[0] * cols / w), cols - 1))
+        cells.setdefault(key, []).append(k)
+    per_cell = max(1, FEATURES // (rows * cols))
+    out = []
+    for found in cells.values():
+        out += sorted(found, key=lambda k: -k.response)[:per_cell]
+    return out
 
 
 def jacobian(H: NDArray, point: tuple[float, float]) -> NDArray:

@@ -55,6 +55,7 @@ CROP_MODES = ("auto", "dynamic", "none")
 # removing all the shake would need more, the path keeps some of it (respect_zoom_budget);
 # on our test clips that cost almost no steadiness (street: 0.943 → 0.942).
 DEFAULT_MAX_ZOOM = 1.15
+LOOSER = 0.25  # the smoothing time constant, as a share, of the path bent towards first
 ESTIMATE_CHUNK = 32  # flow fields held at once in pass 1
 WARP_BATCH = 8  # frames warped together on CUDA
 READOUT_BANDS = 6  # horizontal bands whose rotations date the rows (readout estimation)
@@ -290,7 +291,11 @@ def plan(
     if settings.crop == "none":
         need = np.ones(len(O))
     else:
-        S, need = respect_zoom_budget(O, S, times, zoom_of, settings.max_zoom, settings.smooth)
+        # Where the budget binds, first give up only the slow part of the smoothing.
+        looser = smooth_orientations(O, times, settings.smooth * LOOSER, settings.method)
+        S, need = respect_zoom_budget(
+            O, S, times, zoom_of, settings.max_zoom, settings.smooth, via=(looser,)
+        )
     zoom = choose_zoom(need, times, settings)
     C = S @ np.swapaxes(O, -1, -2)
     H = np.array([homography(K, c, z) for c, z in zip(C, zoom, strict=True)])

@@ -15,6 +15,8 @@ holds one orientation, as on a tripod.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -87,26 +89,52 @@ def blend(S: NDArray, O: NDArray, amount: NDArray) -> NDArray[np.float64]:
 
 
 def respect_zoom_budget(
-    O: NDArray, S: NDArray, times: NDArray, zoom_of, max_zoom: float, smooth: float
+    O: NDArray,
+    S: NDArray,
+    times: NDArray,
+    zoom_of,
+    max_zoom: float,
+    smooth: float,
+    via: Sequence[NDArray] = (),
 ) -> tuple[NDArray, NDArray]:
-    """Bend the smooth path towards the raw one where it would need more than max_zoom.
+    """Bend the smooth path where it would need more than max_zoom.
 
-    ``zoom_of(S)`` gives the zoom each frame needs. The pull is itself smoothed in time,
-    so the path stays smooth; it grows until no frame needs more than ``max_zoom`` (the
-    raw path needs none, so this ends). Returns (S, per-frame zoom).
+    ``zoom_of(S)`` gives the zoom each frame needs. The path is bent towards each of
+    ``via`` in turn (less smoothed paths: they still remove the fast shake and only
+    follow the slower motion closer), and last towards the raw path O, which needs no
+    zoom, so this ends. Returns (S, per-frame zoom).
     """
-    amount = np.zeros(len(O))
-    bent, zoom = S, zoom_of(S)
+    zoom = zoom_of(S)
+    for target in (*via, O):
+        S, zoom = _bend(S, target, times, zoom_of, zoom, max_zoom, smooth)
+        if not (zoom > max_zoom).any():
+            return S, zoom
+    return O.copy(), zoom_of(O)
+
+
+def _bend(
+    S: NDArray,
+    target: NDArray,
+    times: NDArray,
+    zoom_of,
+    zoom: NDArray,
+    max_zoom: float,
+    smooth: float,
+) -> tuple[NDArray, NDArray]:
+    """Pull S towards ``target`` where the zoom is over budget, the pull itself smoothed
+    in time (so the path stays smooth), growing until no frame is over or it is full."""
+    amount = np.zeros(len(S))
+    bent = S
     sigma = max(smooth, 1e-3) / 2
     for _ in range(40):
         over = zoom > max_zoom
-        if not over.any():
-            return bent, zoom
+        if not over.any() or amount[over].min() >= 1.0:
+            break
         amount = np.clip(amount + 0.25 * over, 0.0, 1.0)
         # Spread the pull over neighbouring frames (a Gaussian in time, peak kept).
         spread = np.array(
             [np.max(amount * np.exp(-0.5 * ((times - t) / sigma) ** 2)) for t in times]
         )
-        bent = blend(S, O, spread)
+        bent = blend(S, target, spread)
         zoom = zoom_of(bent)
-    return O.copy(), zoom_of(O)
+    return bent, zoom
