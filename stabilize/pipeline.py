@@ -55,7 +55,7 @@ CROP_MODES = ("auto", "dynamic", "none")
 # removing all the shake would need more, the path keeps some of it (respect_zoom_budget);
 # on our test clips that cost almost no steadiness (street: 0.943 → 0.942).
 DEFAULT_MAX_ZOOM = 1.15
-LOOSER = 0.25  # the smoothing time constant, as a share, of the path bent towards first
+LOOSER = 0.35  # the smoothing time constant, as a share, of the path bent towards first
 ESTIMATE_CHUNK = 32  # flow fields held at once in pass 1
 WARP_BATCH = 8  # frames warped together on CUDA
 READOUT_BANDS = 6  # horizontal bands whose rotations date the rows (readout estimation)

@@ -24,6 +24,9 @@ from rotation import so3
 
 METHODS = ("adaptive", "gaussian", "lock")
 ADAPTIVE_REF_DEG_S = 30.0  # angular speed at which the window halves
+PULL_STEP = 0.05  # how much each round of respect_zoom_budget adds to an over-budget pull
+PULL_ROUNDS = 200
+PULL_SIGMA = 0.5  # the pull's spread in time, as a share of the smoothing time constant
 
 
 def _gaussian_mean(O: NDArray, times: NDArray, sigma: NDArray) -> NDArray:
@@ -125,16 +128,19 @@ def _bend(
     in time (so the path stays smooth), growing until no frame is over or it is full."""
     amount = np.zeros(len(S))
     bent = S
-    sigma = max(smooth, 1e-3) / 2
-    for _ in range(40):
+    sigma = max(smooth, 1e-3) * PULL_SIGMA
+    g = np.exp(-0.5 * ((times[:, None] - times[None, :]) / sigma) ** 2)
+    g /= g.sum(axis=1, keepdims=True)
+    spread = np.zeros(len(S))
+    for _ in range(PULL_ROUNDS):
         over = zoom > max_zoom
-        if not over.any() or amount[over].min() >= 1.0:
+        if not over.any() or spread[over].min() >= 1.0:
             break
-        amount = np.clip(amount + 0.25 * over, 0.0, 1.0)
-        # Spread the pull over neighbouring frames (a Gaussian in time, peak kept).
-        spread = np.array(
-            [np.max(amount * np.exp(-0.5 * ((times - t) / sigma) ** 2)) for t in times]
-        )
+        # The pull grows where the budget is broken and is spread by a normalised
+        # Gaussian in time: smooth (no kinks that would read as jerks), and where it is
+        # too thin to help it keeps growing until it does.
+        amount += PULL_STEP * over
+        spread = np.clip(g @ amount, 0.0, 1.0)
         bent = blend(S, target, spread)
         zoom = zoom_of(bent)
     return bent, zoom
