@@ -265,6 +265,7 @@ def run(
     preview: str = typer.Option(
         "none", help="side-by-side: the original and the stabilised clip next to each other."
     ),
+    size: str | None = typer.Option(None, help="Output WIDTHxHEIGHT (default: the input's)."),
     gyro: Path | None = typer.Option(
         None, help="Stabilise from this gyro log (synchronised to the video) instead."
     ),
@@ -301,6 +302,7 @@ def run(
         max_zoom=max_zoom,
         crop=crop,
         preview=preview == "side-by-side",
+        size=_output_size(size),
         encoding=Encoding(codec=codec, crf=crf, preset=preset),
         gyro=str(gyro) if gyro else None,
         gyro_format=gyro_format,
@@ -385,6 +387,19 @@ def rotations(
                 write_gcsv(tmp, track.times, track.rotations)
     except (VideoError, ValueError, FileExistsError, RuntimeError) as err:
         _fail(str(err))
+
+
+def _output_size(text: str | None) -> tuple[int, int] | None:
+    """--size WIDTHxHEIGHT → (H, W)."""
+    if text is None:
+        return None
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        _fail(f"--size must be WIDTHxHEIGHT, e.g. 1280x720, got {text!r}")
+    if w < 16 or h < 16 or w > 16384 or h > 16384:
+        _fail(f"--size {text}: each side must be 16..16384 pixels")
+    return h, w
 
 
 def _readout(value: str | None, gyro: object) -> float | str | None:

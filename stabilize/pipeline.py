@@ -82,6 +82,7 @@ class Settings:
     gyro_drift: bool = False  # also fit a linear clock drift
     lens: str | None = None  # a Gyroflow lens profile (OpenCV fisheye)
     device: str = "cpu"  # where frames are warped: cpu (OpenCV) or cuda (kornia, batched)
+    size: tuple[int, int] | None = None  # output (H, W); default: the input's
     encoding: Encoding = field(default_factory=Encoding)
 
     def focal_px(self, width: int) -> float:
@@ -336,14 +337,15 @@ def render(
     audio = ffmpeg.input(str(path)).audio if info.has_audio else None
     written = 0
     fps = info.fps or 30.0
-    h, w = info.size
+    h, w = settings.size or info.size
     size = (h, 2 * w) if settings.preview else (h, w)
     variable = is_variable_rate(planned.times)
     encoding = replace(settings.encoding, b_frames=False) if variable else settings.encoding
     target = out.with_name(out.name + ".cfr.mp4") if variable else out
     # I420 end to end where the size allows: no colour conversions, half the bytes.
-    pix_fmt = "yuv420p" if yuv.supports(info.size) else "rgb24"
+    pix_fmt = "yuv420p" if yuv.supports(info.size) and yuv.supports((h, w)) else "rgb24"
     side_by_side = yuv.hstack if pix_fmt == "yuv420p" else lambda a, b: np.hstack([a, b])
+    resize = yuv.resize if pix_fmt == "yuv420p" else resize_rgb
     try:
         with FrameWriter(
             target, size, fps, encoding, audio, copy_audio=True, pix_fmt_in=pix_fmt
@@ -354,6 +356,8 @@ def render(
                 for frame, warped in zip(
                     (f for _, f in batch), planned.warp_many(batch, settings.device), strict=True
                 ):
+                    if settings.size:
+                        frame, warped = resize(frame, (h, w)), resize(warped, (h, w))
                     writer.write(side_by_side(frame, warped) if settings.preview else warped)
                     written += 1
                     progress(1)
@@ -363,6 +367,13 @@ def render(
         if variable:
             target.unlink(missing_ok=True)
     return written
+
+
+def resize_rgb(frame: NDArray[np.uint8], size: tuple[int, int]) -> NDArray[np.uint8]:
+    """An RGB frame at (H, W): area averaging to shrink, bilinear to grow."""
+    h, w = size
+    shrink = h * w < frame.shape[0] * frame.shape[1]
+    return cv2.resize(frame, (w, h), interpolation=cv2.INTER_AREA if shrink else cv2.INTER_LINEAR)
 
 
 def batches(items: Iterable, n: int) -> Iterator[list]:
@@ -446,7 +457,9 @@ def stabilize_video(
     bar = progress or (lambda label, total: _no_progress)
     lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
     bands = READOUT_BANDS if settings.gyro and settings.readout_ms == "auto" else 0
-    track = estimate_rotations(src, info, settings, bar("estimating", None), bands=bands, lens=lens)
+    times = frame_times(src, info.input_args)
+    estimating = bar("estimating", max(len(times) - 1, 0))
+    track = estimate_rotations(src, info, settings, estimating, times, bands=bands, lens=lens)
     times, support = track.times, track.support
     gyro_summary, rolling = None, None
     if settings.gyro:

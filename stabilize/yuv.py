@@ -79,6 +79,19 @@ def remap(
     )
 
 
+def resize(frame: NDArray[np.uint8], size: tuple[int, int]) -> NDArray[np.uint8]:
+    """An I420 frame at (H, W) (both even): every plane resized alike."""
+    h, w = size
+    y, u, v = split(frame)
+    shrink = h * w < y.size
+    mode = cv2.INTER_AREA if shrink else cv2.INTER_LINEAR
+    return join(
+        cv2.resize(y, (w, h), interpolation=mode),
+        cv2.resize(u, (w // 2, h // 2), interpolation=mode),
+        cv2.resize(v, (w // 2, h // 2), interpolation=mode),
+    )
+
+
 def hstack(a: NDArray[np.uint8], b: NDArray[np.uint8]) -> NDArray[np.uint8]:
     """Two I420 frames side by side."""
     return join(*(np.hstack([p, q]) for p, q in zip(split(a), split(b), strict=True)))

@@ -226,3 +226,12 @@ def test_side_by_side_preview(shaky, tmp_path):
     assert probe(out).size == (180, 640)
     left = next(read_frames(out))[:, :320].astype(float)
     assert np.abs(left - next(read_frames(shaky)).astype(float)).mean() < 3
+
+
+def test_output_size(shaky, tmp_path):
+    out = tmp_path / "small.mp4"
+    result = RUNNER.invoke(app, ["run", str(shaky), str(out), "--size", "160x90", "-q"])
+    assert result.exit_code == 0, result.output
+    assert probe(out).size == (90, 160) and len(frame_times(out)) == 60
+    bad = RUNNER.invoke(app, ["run", str(shaky), str(tmp_path / "x.mp4"), "--size", "big"])
+    assert bad.exit_code != 0 and "WIDTHxHEIGHT" in bad.output
