@@ -115,7 +115,8 @@ class CameraPath:
         """Output frames of (k, frame) pairs, RGB or I420 (2-D); on CUDA the plain
         homography warps run as one batch (lens and rolling-shutter maps stay on the CPU)."""
         plain = self.lens is None and self.row_homographies is None
-        if not (device.startswith("cuda") and plain):
+        eight_bit = all(frame.dtype == np.uint8 for _, frame in batch)
+        if not (device.startswith("cuda") and plain and eight_bit):
             return [self.warp(k, frame) for k, frame in batch]
         H = self.homographies[[k for k, _ in batch]]
         frames = np.stack([frame for _, frame in batch])
@@ -125,7 +126,7 @@ class CameraPath:
         Hc = np.array([yuv.chroma_homography(h) for h in H])
         warped = [
             warp_frames_torch(p, M, device, fill)
-            for p, M, fill in zip(planes, (H, Hc, Hc), yuv.BLACK, strict=True)
+            for p, M, fill in zip(planes, (H, Hc, Hc), yuv.black(frames), strict=True)
         ]
         return [yuv.join(*parts) for parts in zip(*warped, strict=True)]
 
@@ -343,9 +344,12 @@ def render(
     encoding = replace(settings.encoding, b_frames=False) if variable else settings.encoding
     target = out.with_name(out.name + ".cfr.mp4") if variable else out
     # I420 end to end where the size allows: no colour conversions, half the bytes.
-    pix_fmt = "yuv420p" if yuv.supports(info.size) and yuv.supports((h, w)) else "rgb24"
-    side_by_side = yuv.hstack if pix_fmt == "yuv420p" else lambda a, b: np.hstack([a, b])
-    resize = yuv.resize if pix_fmt == "yuv420p" else resize_rgb
+    planar = yuv.supports(info.size) and yuv.supports((h, w))
+    pix_fmt = yuv.pipe_format(info.pix_fmt) if planar else "rgb24"
+    if pix_fmt == "yuv420p10le" and encoding.pix_fmt == "yuv420p":
+        encoding = replace(encoding, pix_fmt=pix_fmt)  # keep a 10-bit source's depth
+    side_by_side = yuv.hstack if planar else lambda a, b: np.hstack([a, b])
+    resize = yuv.resize if planar else resize_rgb
     try:
         with FrameWriter(
             target, size, fps, encoding, audio, copy_audio=True, pix_fmt_in=pix_fmt

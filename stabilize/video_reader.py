@@ -104,7 +104,8 @@ def read_frames(
     pix_fmt: str = "rgb24",
 ) -> Iterator[NDArray[np.uint8]]:
     """RGB uint8 frames (H, W, 3), streamed; resized to ``size`` (H, W) if given.
-    ``pix_fmt="yuv420p"`` gives I420 frames (3H/2, W) instead (:mod:`stabilize.yuv`).
+    ``pix_fmt="yuv420p"`` gives I420 frames (3H/2, W) instead (:mod:`stabilize.yuv`), and
+    ``"yuv420p10le"`` 10-bit ones (uint16).
 
     FFmpeg applies the display rotation, so frames come upright. A stream that ends
     early or breaks raises :class:`VideoError` after the frames that did decode.
@@ -126,14 +127,16 @@ def read_frames(
         .run_async(cmd=ffmpeg_exe(), pipe_stdout=True, pipe_stderr=True)
     )
     widen_pipe(process.stdout)
-    shape = (h * 3 // 2, w) if pix_fmt == "yuv420p" else (h, w, 3)
-    frame_bytes = int(np.prod(shape))
+    planar = pix_fmt.startswith("yuv420p")
+    shape = (h * 3 // 2, w) if planar else (h, w, 3)
+    dtype = np.uint16 if pix_fmt.endswith("10le") else np.uint8
+    frame_bytes = int(np.prod(shape)) * np.dtype(dtype).itemsize
     try:
         while True:
             buf = process.stdout.read(frame_bytes)
             if len(buf) < frame_bytes:
                 break
-            yield np.frombuffer(buf, np.uint8).reshape(shape)
+            yield np.frombuffer(buf, dtype).reshape(shape)
     finally:
         process.stdout.close()
         err = process.stderr.read().decode(errors="replace").strip()

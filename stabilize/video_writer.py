@@ -47,7 +47,8 @@ class FrameWriter:
     ) -> None:
         encoding = encoding or Encoding()
         h, w = size
-        self.shape = (h * 3 // 2, w) if pix_fmt_in == "yuv420p" else (h, w, 3)
+        self.shape = (h * 3 // 2, w) if pix_fmt_in.startswith("yuv420p") else (h, w, 3)
+        self.dtype = np.uint16 if pix_fmt_in.endswith("10le") else np.uint8
         video = ffmpeg.input(
             "pipe:", format="rawvideo", pix_fmt=pix_fmt_in, s=f"{w}x{h}", framerate=fps
         )
@@ -77,8 +78,9 @@ class FrameWriter:
         widen_pipe(self._process.stdin)
 
     def write(self, frame: NDArray[np.uint8]) -> None:
-        if frame.shape != self.shape or frame.dtype != np.uint8:
-            raise ValueError(f"frame must be uint8 {self.shape}, got {frame.dtype} {frame.shape}")
+        if frame.shape != self.shape or frame.dtype != self.dtype:
+            want = f"{np.dtype(self.dtype)} {self.shape}"
+            raise ValueError(f"frame must be {want}, got {frame.dtype} {frame.shape}")
         self._process.stdin.write(np.ascontiguousarray(frame).tobytes())
 
     def close(self) -> None:

@@ -1,4 +1,5 @@
-"""Frames as I420 (planar YUV 4:2:0), the layout H.264 stores.
+"""Frames as I420 (planar YUV 4:2:0), the layout H.264 stores; 8 bits (uint8) or 10
+(uint16, ``yuv420p10le``), so a 10-bit source stays 10 bits.
 
 Pass 2 decodes, warps and encodes in I420 rather than RGB: FFmpeg then converts no colours
 on either side, half as many bytes cross the pipes, and a warp touches 1.5 bytes per
@@ -18,8 +19,20 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-BLACK = (16, 128, 128)  # limited-range black: Y, U, V
+BLACK = (16, 128, 128)  # limited-range black: Y, U, V (8 bits; ×4 at 10 bits)
+FORMATS = {"yuv420p": np.uint8, "yuv420p10le": np.uint16}  # pipe format → sample type
 HALF = np.array([[0.5, 0.0, -0.25], [0.0, 0.5, -0.25], [0.0, 0.0, 1.0]])  # S above
+
+
+def black(frame: NDArray) -> tuple[int, int, int]:
+    """Black for a frame's sample depth (uint16 frames carry 10 bits)."""
+    scale = 4 if frame.dtype == np.uint16 else 1
+    return tuple(v * scale for v in BLACK)
+
+
+def pipe_format(source_pix_fmt: str) -> str:
+    """The I420 pipe format that keeps a source's depth: 10 bits stay 10 bits."""
+    return "yuv420p10le" if "10" in source_pix_fmt else "yuv420p"
 
 
 def supports(size: tuple[int, int]) -> bool:
@@ -49,12 +62,13 @@ def warp(frame: NDArray[np.uint8], H: NDArray) -> NDArray[np.uint8]:
     """cv2.warpPerspective of every plane by H (chroma by S H S⁻¹); black outside."""
     y, u, v = split(frame)
     Hc = chroma_homography(H)
+    fill = black(frame)
 
     def one(plane: NDArray, M: NDArray, fill: int) -> NDArray:
         size = (plane.shape[1], plane.shape[0])
         return cv2.warpPerspective(plane, M, size, flags=cv2.INTER_LINEAR, borderValue=fill)
 
-    return join(one(y, H, BLACK[0]), one(u, Hc, BLACK[1]), one(v, Hc, BLACK[2]))
+    return join(one(y, H, fill[0]), one(u, Hc, fill[1]), one(v, Hc, fill[2]))
 
 
 def remap(
@@ -72,10 +86,11 @@ def remap(
     def chroma_source(pts: NDArray) -> NDArray:
         return (source(2.0 * pts + 0.5) + 0.5) / 2.0 - 0.5
 
+    fill = black(frame)
     return join(
-        remap_plane(y, source, BLACK[0]),
-        remap_plane(u, chroma_source, BLACK[1]),
-        remap_plane(v, chroma_source, BLACK[2]),
+        remap_plane(y, source, fill[0]),
+        remap_plane(u, chroma_source, fill[1]),
+        remap_plane(v, chroma_source, fill[2]),
     )
 
 

@@ -235,3 +235,14 @@ def test_output_size(shaky, tmp_path):
     assert probe(out).size == (90, 160) and len(frame_times(out)) == 60
     bad = RUNNER.invoke(app, ["run", str(shaky), str(tmp_path / "x.mp4"), "--size", "big"])
     assert bad.exit_code != 0 and "WIDTHxHEIGHT" in bad.output
+
+
+def test_a_10_bit_source_stays_10_bit(shaky, tmp_path):
+    ten = tmp_path / "ten.mp4"
+    encode = ["-c:v", "libx264", "-pix_fmt", "yuv420p10le", "-c:a", "copy"]
+    subprocess.run([ffmpeg_exe(), "-v", "error", "-i", str(shaky), *encode, str(ten)], check=True)
+    out = tmp_path / "out.mp4"
+    summary, _ = stabilize_video(ten, out, Settings(fov=70.0))
+    assert probe(out).pix_fmt.startswith("yuv420p10") and summary["frames"] == 60
+    frames = list(read_frames(out))
+    assert len(frames) == 60 and min(f.mean() for f in frames) > 20  # content, not black
