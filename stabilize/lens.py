@@ -17,6 +17,7 @@ when a fisheye frame is warped by a homography.
 
 from __future__ import annotations
 
+import functools
 import json
 from dataclasses import dataclass
 from pathlib import Path
@@ -120,9 +121,14 @@ def unproject(lens: Lens, pts: NDArray) -> NDArray[np.float64]:
 
 def max_angle(lens: Lens) -> float:
     """The largest θ where θ_d(θ) still increases (beyond it the model folds back), ≤ π."""
+    return _max_angle(tuple(float(k) for k in lens.coeffs))
+
+
+@functools.lru_cache(maxsize=32)
+def _max_angle(coeffs: tuple[float, float, float, float]) -> float:
     theta = np.linspace(0.0, np.pi, 2001)
     t2 = theta * theta
-    k1, k2, k3, k4 = lens.coeffs
+    k1, k2, k3, k4 = coeffs
     slope = 1 + t2 * (3 * k1 + t2 * (5 * k2 + t2 * (7 * k3 + t2 * 9 * k4)))
     bad = np.flatnonzero(slope <= 0)
     return float(theta[bad[0] - 1]) if bad.size else float(np.pi)

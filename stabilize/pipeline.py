@@ -41,7 +41,6 @@ from stabilize.warping import (
     homography,
     lens_source,
     remap_from,
-    required_zoom,
     required_zooms,
     rolling_source,
     warp_frame,
@@ -285,10 +284,7 @@ def plan(
         return C if rolling is None else C[:, None] @ np.swapaxes(rolling.turns, -1, -2)
 
     def zoom_of(path: NDArray) -> NDArray:
-        limit = settings.max_zoom * 1.001
-        if rolling is None and lens is None:
-            return required_zooms(K, corrections(path), size, limit)
-        return np.array([required_zoom(K, c, size, limit, rows, lens) for c in corrections(path)])
+        return required_zooms(K, corrections(path), size, settings.max_zoom * 1.001, rows, lens)
 
     if settings.crop == "none":
         need = np.ones(len(O))

@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from stabilize.lens import Lens, project, unproject
 
 BORDER_SAMPLES = 16  # points per edge checked for coverage
+ZOOM_STEPS = 16  # bisection steps of the zoom search
 ROW_ITERATIONS = 2  # fixed-point steps for an output pixel's source row
 MAP_STEP = 8  # output pixels between exactly computed points of a rolling-shutter map
 
@@ -68,9 +69,7 @@ def back_project(Hinv: NDArray, rows: NDArray | None, pts: NDArray) -> NDArray[n
         return ph @ Hinv.T
     out = ph @ Hinv[len(rows) // 2].T
     for _ in range(ROW_ITERATIONS):
-        y = np.clip(out[:, 1] / np.where(out[:, 2] > 0, out[:, 2], 1.0), rows[0], rows[-1])
-        k = np.clip(np.searchsorted(rows, y) - 1, 0, len(rows) - 2)
-        frac = ((y - rows[k]) / (rows[k + 1] - rows[k]))[:, None, None]
+        k, frac = _knot(out[:, :2] / np.where(out[:, 2:] > 0, out[:, 2:], 1.0), rows)
         H = Hinv[k] + frac * (Hinv[k + 1] - Hinv[k])
         out = np.einsum("mij,mj->mi", H, ph)
     return out
@@ -80,6 +79,73 @@ def inverses(H: NDArray) -> NDArray[np.float64]:
     """Inverse homographies, scaled to H[2, 2] = 1 so that they interpolate."""
     Hinv = np.linalg.inv(H)
     return Hinv / Hinv[..., 2:, 2:]
+
+
+def border_sources(
+    K: NDArray,
+    C: NDArray,
+    zoom: NDArray,
+    size: tuple[int, int],
+    rows: NDArray | None = None,
+    lens: Lens | None = None,
+) -> NDArray[np.float64]:
+    """Input pixels (N, M, 2) of the output border's M points, for N frames at once:
+    corrections C (N, 3, 3), or (N, B, 3, 3) at knot ``rows``, zooms (N,); NaN where a
+    point has no source (behind the camera, or outside the lens's reach)."""
+    C = np.asarray(C, dtype=np.float64)
+    zoom = np.asarray(zoom, dtype=np.float64)
+    pts = _border(size)
+    n, m = len(C), len(pts)
+    if lens is not None:
+        c = lens.K[:2, 2]
+        scaled = c + (pts[None] - c) / zoom[:, None, None]  # unproject at f·zoom
+        rays = unproject(lens, scaled.reshape(-1, 2)).reshape(n, m, 3)
+
+        def source(Cp: NDArray) -> NDArray:  # Cp (N, M, 3, 3) or (N, 3, 3)
+            spec = "nmj,nmji->nmi" if Cp.ndim == 4 else "nmj,nji->nmi"
+            turned = np.einsum(spec, rays, Cp)
+            return project(lens, turned.reshape(-1, 3)).reshape(n, m, 2)
+
+    else:
+        Z = np.zeros((n, 3, 3))
+        Z[:, 0, 0], Z[:, 1, 1] = K[0, 0] * zoom, K[1, 1] * zoom
+        Z[:, 0, 2], Z[:, 1, 2], Z[:, 2, 2] = K[0, 2], K[1, 2], 1.0
+        Zp = Z[:, None] if C.ndim == 4 else Z
+        Hinv = inverses(Zp @ C @ np.linalg.inv(K))  # per frame (and knot)
+        ph = np.c_[pts, np.ones(m)]
+
+        def homogeneous(q: NDArray) -> NDArray:
+            z = np.where(q[..., 2] > 1e-12, q[..., 2], np.nan)
+            return q[..., :2] / z[..., None]
+
+        if rows is None:
+            return homogeneous(np.einsum("nij,mj->nmi", Hinv, ph))
+        # Interpolating the inverse homographies between knots, as the warp does.
+        src = homogeneous(np.einsum("nij,mj->nmi", Hinv[:, len(rows) // 2], ph))
+        frame = np.arange(n)[:, None]
+        for _ in range(ROW_ITERATIONS):
+            k, frac = _knot(src, rows)
+            H = Hinv[frame, k] + frac * (Hinv[frame, k + 1] - Hinv[frame, k])
+            src = homogeneous(np.einsum("nmij,mj->nmi", H, ph))
+        return src
+
+    if rows is None:
+        return source(C)
+    src = source(C[:, len(rows) // 2])
+    frame = np.arange(n)[:, None]
+    for _ in range(ROW_ITERATIONS):
+        k, frac = _knot(src, rows)
+        # Turns between knots are tiny: interpolating the matrices is exact enough.
+        src = source(C[frame, k] + frac * (C[frame, k + 1] - C[frame, k]))
+    return src
+
+
+def _knot(src: NDArray, rows: NDArray) -> tuple[NDArray, NDArray]:
+    """For source pixels (..., 2): the knot below each one's row, and the fraction of the
+    way to the next knot, (...,) and (..., 1, 1)."""
+    y = np.clip(np.nan_to_num(src[..., 1], nan=rows[0]), rows[0], rows[-1])
+    k = np.clip(np.searchsorted(rows, y) - 1, 0, len(rows) - 2)
+    return k, ((y - rows[k]) / (rows[k + 1] - rows[k]))[..., None, None]
 
 
 def covers(
@@ -95,18 +161,16 @@ def covers(
     ``C`` is one correction, or one per knot row in ``rows`` (rolling shutter); with a
     ``lens`` the border is mapped through it instead of a homography.
     """
+    return bool(_covered(K, np.asarray(C)[None], np.array([zoom]), size, rows, lens)[0])
+
+
+def _covered(K, C, zoom, size, rows, lens) -> NDArray[np.bool_]:
     h, w = size
-    if lens is not None:
-        xy = lens_source(lens, C, zoom, _border(size), rows)
-        if not np.isfinite(xy).all():
-            return False
-        x, y = xy[:, 0], xy[:, 1]
-    else:
-        pts = back_project(inverses(homography(K, C, zoom)), rows, _border(size))
-        if np.any(pts[:, 2] <= 0):
-            return False
-        x, y = pts[:, 0] / pts[:, 2], pts[:, 1] / pts[:, 2]
-    return bool(np.all((x >= -0.5) & (x <= w - 0.5) & (y >= -0.5) & (y <= h - 0.5)))
+    xy = border_sources(K, C, zoom, size, rows, lens)
+    x, y = xy[..., 0], xy[..., 1]
+    with np.errstate(invalid="ignore"):
+        inside = (x >= -0.5) & (x <= w - 0.5) & (y >= -0.5) & (y <= h - 0.5)
+    return inside.all(axis=1)
 
 
 def required_zoom(
@@ -118,44 +182,28 @@ def required_zoom(
     lens: Lens | None = None,
 ) -> float:
     """The smallest zoom ≥ 1 with no border in frame (bisection); inf if above max_zoom."""
-    if covers(K, C, 1.0, size, rows, lens):
-        return 1.0
-    if not covers(K, C, max_zoom, size, rows, lens):
-        return np.inf
-    lo, hi = 1.0, max_zoom
-    for _ in range(30):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if covers(K, C, mid, size, rows, lens) else (mid, hi)
-    return hi
+    return float(required_zooms(K, np.asarray(C)[None], size, max_zoom, rows, lens)[0])
 
 
 def required_zooms(
-    K: NDArray, C: NDArray, size: tuple[int, int], max_zoom: float = 4.0
+    K: NDArray,
+    C: NDArray,
+    size: tuple[int, int],
+    max_zoom: float = 4.0,
+    rows: NDArray | None = None,
+    lens: Lens | None = None,
 ) -> NDArray[np.float64]:
-    """:func:`required_zoom` of many corrections (N, 3, 3) at once (pinhole, global
-    shutter): the same bisection, run on all frames together."""
+    """:func:`required_zoom` of N frames' corrections at once: the bisection runs on all
+    of them together (about 1e-5 of zoom in 16 steps)."""
     C = np.asarray(C, dtype=np.float64)
-    h, w = size
-    pts = np.c_[_border(size), np.ones(4 * BORDER_SAMPLES)]
 
     def covered(zoom: NDArray) -> NDArray[np.bool_]:
-        Z = np.zeros((len(C), 3, 3))
-        Z[:, 0, 0] = Z[:, 1, 1] = zoom
-        Z[:, 0, 2], Z[:, 1, 2], Z[:, 2, 2] = K[0, 2], K[1, 2], 1.0
-        Z[:, 0, 0] *= K[0, 0]
-        Z[:, 1, 1] *= K[1, 1]
-        Hinv = np.linalg.inv(Z @ C @ np.linalg.inv(K))
-        q = pts @ np.swapaxes(Hinv, -1, -2)  # (N, M, 3)
-        ok = (q[..., 2] > 0).all(axis=1)
-        z = np.where(q[..., 2] > 0, q[..., 2], 1.0)
-        x, y = q[..., 0] / z, q[..., 1] / z
-        inside = (x >= -0.5) & (x <= w - 0.5) & (y >= -0.5) & (y <= h - 0.5)
-        return ok & inside.all(axis=1)
+        return _covered(K, C, zoom, size, rows, lens)
 
     lo, hi = np.ones(len(C)), np.full(len(C), float(max_zoom))
     done = covered(lo)
     hopeless = ~covered(hi) & ~done
-    for _ in range(30):
+    for _ in range(ZOOM_STEPS):
         mid = 0.5 * (lo + hi)
         fits = covered(mid)
         hi = np.where(fits, mid, hi)
@@ -199,9 +247,7 @@ def lens_source(
         return project(lens, rays @ C)
     src = project(lens, rays @ C[len(rows) // 2])
     for _ in range(ROW_ITERATIONS):
-        y = np.clip(np.nan_to_num(src[:, 1], nan=rows[0]), rows[0], rows[-1])
-        k = np.clip(np.searchsorted(rows, y) - 1, 0, len(rows) - 2)
-        frac = ((y - rows[k]) / (rows[k + 1] - rows[k]))[:, None, None]
+        k, frac = _knot(src, rows)
         Ck = C[k] + frac * (C[k + 1] - C[k])  # turns between knots are tiny: lerp is exact enough
         src = project(lens, np.einsum("mj,mji->mi", rays, Ck))
     return src
