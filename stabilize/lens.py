@@ -42,12 +42,6 @@ class Lens:
     readout_s: float | None = None  # the profile's frame_readout_time
     source: str = ""
 
-    def zoomed(self, zoom: float) -> Lens:
-        K = self.K.copy()
-        K[0, 0] *= zoom
-        K[1, 1] *= zoom
-        return Lens(K, self.coeffs, self.readout_s, self.source)
-
 
 def read_lens_profile(path: str | Path, size: tuple[int, int]) -> Lens:
     """A Gyroflow lens profile, scaled to a video of (H, W) pixels."""

@@ -102,10 +102,9 @@ class CameraPath:
     zoom: NDArray  # (N,) applied zoom
     homographies: NDArray  # (N, 3, 3) input → output pixels (the middle row's)
     K: NDArray
-    # Rolling shutter: the homographies of each knot row (N, B, 3, 3) at input rows (B,).
-    row_homographies: NDArray | None = None
+    # Rolling shutter: the corrections of each knot row (N, B, 3, 3) at input rows (B,).
+    row_corrections: NDArray | None = None
     knot_rows: NDArray | None = None
-    row_corrections: NDArray | None = None  # (N, B, 3, 3)
     lens: Lens | None = None  # fisheye: frames are warped through it, not by homographies
 
     def warp_many(
@@ -113,7 +112,7 @@ class CameraPath:
     ) -> list[NDArray[np.uint8]]:
         """Output frames of (k, frame) pairs, RGB or I420 (2-D); on CUDA the plain
         homography warps run as one batch (lens and rolling-shutter maps stay on the CPU)."""
-        plain = self.lens is None and self.row_homographies is None
+        plain = self.lens is None and self.row_corrections is None
         eight_bit = all(frame.dtype == np.uint8 for _, frame in batch)
         if not (device.startswith("cuda") and plain and eight_bit):
             return [self.warp(k, frame) for k, frame in batch]
@@ -132,19 +131,16 @@ class CameraPath:
     def warp(self, k: int, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
         """Frame k of the output, from frame k of the input (RGB, or I420 when 2-D)."""
         planar = frame.ndim == 2
-        if self.lens is None and self.row_homographies is None:
+        rolling = self.row_corrections is not None
+        if self.lens is None and not rolling:
             H = self.homographies[k]
             return yuv.warp(frame, H) if planar else warp_frame(frame, H)
+        C = self.row_corrections[k] if rolling else self.smooth[k] @ self.raw[k].T
         if self.lens is not None:
-            rolling = self.row_corrections is not None
-            C = self.row_corrections[k] if rolling else self.smooth[k] @ self.raw[k].T
-            lens, zoom, rows = self.lens, self.zoom[k], self.knot_rows
-
-            def source(pts: NDArray) -> NDArray:
-                return lens_source(lens, C, zoom, pts, rows)
+            source = lens_source(self.lens, C, self.zoom[k], self.knot_rows)
         else:
-            source = rolling_source(self.row_homographies[k], self.knot_rows)
-        return yuv.remap(frame, source, remap_from) if planar else remap_from(frame, source)
+            source = rolling_source(homography(self.K, C, self.zoom[k]), self.knot_rows)
+        return yuv.remap(frame, source) if planar else remap_from(frame, source)
 
 
 Progress = Callable[[int], None]
@@ -299,9 +295,7 @@ def plan(
     H = np.array([homography(K, c, z) for c, z in zip(C, zoom, strict=True)])
     if rolling is None:
         return CameraPath(times, rotations, support, O, S, zoom, H, K, lens=lens)
-    C_rows = corrections(S)
-    H_rows = np.array([homography(K, c, z) for c, z in zip(C_rows, zoom, strict=True)])
-    return CameraPath(times, rotations, support, O, S, zoom, H, K, H_rows, rows, C_rows, lens)
+    return CameraPath(times, rotations, support, O, S, zoom, H, K, corrections(S), rows, lens)
 
 
 def choose_zoom(need: NDArray, times: NDArray, settings: Settings) -> NDArray:

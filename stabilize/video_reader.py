@@ -112,7 +112,8 @@ def read_frames(
     """
     info = info or probe(path)
     h, w = size or info.size
-    options = {k.lstrip("-"): v for k, v in zip(*[iter(info.input_args)] * 2, strict=True)}
+    args = info.input_args
+    options = {k.lstrip("-"): v for k, v in zip(args[::2], args[1::2], strict=True)}
     shrink = size is not None and size != info.size
     if shrink:
         # Deblocking only smooths detail that the downscale averages away anyway; skipping

@@ -31,10 +31,12 @@ ROW_ITERATIONS = 2  # fixed-point steps for an output pixel's source row
 MAP_STEP = 8  # output pixels between exactly computed points of a rolling-shutter map
 
 
-def zoomed(K: NDArray, zoom: float) -> NDArray:
-    out = np.array(K, dtype=np.float64, copy=True)
-    out[0, 0] *= zoom
-    out[1, 1] *= zoom
+def zoomed(K: NDArray, zoom: float | NDArray) -> NDArray:
+    """K with the focal length times the zoom (a stack of them for an array of zooms)."""
+    zoom = np.asarray(zoom, dtype=np.float64)
+    out = np.broadcast_to(np.asarray(K, dtype=np.float64), (*zoom.shape, 3, 3)).copy()
+    out[..., 0, 0] *= zoom
+    out[..., 1, 1] *= zoom
     return out
 
 
@@ -58,27 +60,63 @@ def _border(size: tuple[int, int]) -> NDArray:
     )
 
 
-def back_project(Hinv: NDArray, rows: NDArray | None, pts: NDArray) -> NDArray[np.float64]:
-    """Input pixels (M, 3) homogeneous of output pixels ``pts`` (M, 2).
-
-    ``Hinv`` is one inverse homography (3, 3), or one per knot row (B, 3, 3) with the
-    input rows ``rows`` (B,) they hold at (rolling shutter).
-    """
-    ph = np.c_[pts, np.ones(len(pts))]
-    if rows is None:
-        return ph @ Hinv.T
-    out = ph @ Hinv[len(rows) // 2].T
-    for _ in range(ROW_ITERATIONS):
-        k, frac = _knot(out[:, :2] / np.where(out[:, 2:] > 0, out[:, 2:], 1.0), rows)
-        H = Hinv[k] + frac * (Hinv[k + 1] - Hinv[k])
-        out = np.einsum("mij,mj->mi", H, ph)
-    return out
-
-
 def inverses(H: NDArray) -> NDArray[np.float64]:
     """Inverse homographies, scaled to H[2, 2] = 1 so that they interpolate."""
     Hinv = np.linalg.inv(H)
     return Hinv / Hinv[..., 2:, 2:]
+
+
+def homography_sources(
+    Hinv: NDArray, pts: NDArray, rows: NDArray | None = None
+) -> NDArray[np.float64]:
+    """Input pixels (N, M, 2) of output pixels ``pts`` (M, 2) for N frames' inverse
+    homographies (N, 3, 3), or (N, B, 3, 3) at knot ``rows`` (rolling shutter; scaled
+    as by :func:`inverses`, so that they interpolate). NaN behind the camera."""
+    ph = np.c_[pts, np.ones(len(pts))]
+
+    def apply(H: NDArray) -> NDArray:
+        q = np.einsum("nmij,mj->nmi" if H.ndim == 4 else "nij,mj->nmi", H, ph)
+        z = np.where(q[..., 2] > 1e-12, q[..., 2], np.nan)
+        return q[..., :2] / z[..., None]
+
+    return _through_rows(Hinv, rows, apply)
+
+
+def lens_sources(
+    lens: Lens, C: NDArray, zoom: NDArray, pts: NDArray, rows: NDArray | None = None
+) -> NDArray[np.float64]:
+    """Input pixels (N, M, 2) of output pixels ``pts`` (M, 2) through a lens: unproject
+    with the lens at f·zoom, turn by Cᵀ, project with the lens. ``C`` (N, 3, 3), or
+    (N, B, 3, 3) at knot ``rows``; NaN outside the lens's reach."""
+    C = np.asarray(C, dtype=np.float64)
+    zoom = np.asarray(zoom, dtype=np.float64)
+    n, m = len(C), len(pts)
+    c = lens.K[:2, 2]
+    scaled = c + (pts[None] - c) / zoom[:, None, None]  # the zoomed lens's unprojection
+    rays = unproject(lens, scaled.reshape(-1, 2)).reshape(n, m, 3)
+
+    def apply(Cp: NDArray) -> NDArray:
+        turned = np.einsum("nmj,nmji->nmi" if Cp.ndim == 4 else "nmj,nji->nmi", rays, Cp)
+        return project(lens, turned.reshape(-1, 3)).reshape(n, m, 2)
+
+    return _through_rows(C, rows, apply)
+
+
+def _through_rows(stack: NDArray, rows: NDArray | None, apply) -> NDArray:
+    """``apply`` per frame (N, 3, 3); with knot ``rows``, the source row of every point
+    is found by fixed-point iteration from the middle knot, the stack (N, B, 3, 3)
+    interpolated per point (N, M, 3, 3). Between knots the turns are tiny, so
+    interpolating the matrices linearly is exact enough."""
+    if rows is None:
+        return apply(stack)
+    src = apply(stack[:, len(rows) // 2])
+    frame = np.arange(len(stack))[:, None]
+    for _ in range(ROW_ITERATIONS):
+        y = np.clip(np.nan_to_num(src[..., 1], nan=rows[0]), rows[0], rows[-1])
+        k = np.clip(np.searchsorted(rows, y) - 1, 0, len(rows) - 2)
+        frac = ((y - rows[k]) / (rows[k + 1] - rows[k]))[..., None, None]
+        src = apply(stack[frame, k] + frac * (stack[frame, k + 1] - stack[frame, k]))
+    return src
 
 
 def border_sources(
@@ -90,62 +128,15 @@ def border_sources(
     lens: Lens | None = None,
 ) -> NDArray[np.float64]:
     """Input pixels (N, M, 2) of the output border's M points, for N frames at once:
-    corrections C (N, 3, 3), or (N, B, 3, 3) at knot ``rows``, zooms (N,); NaN where a
-    point has no source (behind the camera, or outside the lens's reach)."""
+    corrections C (N, 3, 3), or (N, B, 3, 3) at knot ``rows``, zooms (N,)."""
     C = np.asarray(C, dtype=np.float64)
     zoom = np.asarray(zoom, dtype=np.float64)
     pts = _border(size)
-    n, m = len(C), len(pts)
     if lens is not None:
-        c = lens.K[:2, 2]
-        scaled = c + (pts[None] - c) / zoom[:, None, None]  # unproject at f·zoom
-        rays = unproject(lens, scaled.reshape(-1, 2)).reshape(n, m, 3)
-
-        def source(Cp: NDArray) -> NDArray:  # Cp (N, M, 3, 3) or (N, 3, 3)
-            spec = "nmj,nmji->nmi" if Cp.ndim == 4 else "nmj,nji->nmi"
-            turned = np.einsum(spec, rays, Cp)
-            return project(lens, turned.reshape(-1, 3)).reshape(n, m, 2)
-
-    else:
-        Z = np.zeros((n, 3, 3))
-        Z[:, 0, 0], Z[:, 1, 1] = K[0, 0] * zoom, K[1, 1] * zoom
-        Z[:, 0, 2], Z[:, 1, 2], Z[:, 2, 2] = K[0, 2], K[1, 2], 1.0
-        Zp = Z[:, None] if C.ndim == 4 else Z
-        Hinv = inverses(Zp @ C @ np.linalg.inv(K))  # per frame (and knot)
-        ph = np.c_[pts, np.ones(m)]
-
-        def homogeneous(q: NDArray) -> NDArray:
-            z = np.where(q[..., 2] > 1e-12, q[..., 2], np.nan)
-            return q[..., :2] / z[..., None]
-
-        if rows is None:
-            return homogeneous(np.einsum("nij,mj->nmi", Hinv, ph))
-        # Interpolating the inverse homographies between knots, as the warp does.
-        src = homogeneous(np.einsum("nij,mj->nmi", Hinv[:, len(rows) // 2], ph))
-        frame = np.arange(n)[:, None]
-        for _ in range(ROW_ITERATIONS):
-            k, frac = _knot(src, rows)
-            H = Hinv[frame, k] + frac * (Hinv[frame, k + 1] - Hinv[frame, k])
-            src = homogeneous(np.einsum("nmij,mj->nmi", H, ph))
-        return src
-
-    if rows is None:
-        return source(C)
-    src = source(C[:, len(rows) // 2])
-    frame = np.arange(n)[:, None]
-    for _ in range(ROW_ITERATIONS):
-        k, frac = _knot(src, rows)
-        # Turns between knots are tiny: interpolating the matrices is exact enough.
-        src = source(C[frame, k] + frac * (C[frame, k + 1] - C[frame, k]))
-    return src
-
-
-def _knot(src: NDArray, rows: NDArray) -> tuple[NDArray, NDArray]:
-    """For source pixels (..., 2): the knot below each one's row, and the fraction of the
-    way to the next knot, (...,) and (..., 1, 1)."""
-    y = np.clip(np.nan_to_num(src[..., 1], nan=rows[0]), rows[0], rows[-1])
-    k = np.clip(np.searchsorted(rows, y) - 1, 0, len(rows) - 2)
-    return k, ((y - rows[k]) / (rows[k + 1] - rows[k]))[..., None, None]
+        return lens_sources(lens, C, zoom, pts, rows)
+    Z = zoomed(K, zoom)
+    Zp = Z[:, None] if C.ndim == 4 else Z
+    return homography_sources(inverses(Zp @ C @ np.linalg.inv(K)), pts, rows)
 
 
 def covers(
@@ -226,38 +217,21 @@ def warp_frame_rolling(frame: NDArray[np.uint8], H: NDArray, rows: NDArray) -> N
 
 def rolling_source(H: NDArray, rows: NDArray):
     """The map output pixels (M, 2) → input pixels of row-dependent homographies."""
-    Hinv = inverses(H)
-
-    def source(pts: NDArray) -> NDArray:
-        src = back_project(Hinv, rows, pts)
-        z = np.where(src[:, 2] > 1e-9, src[:, 2], np.nan)
-        return src[:, :2] / z[:, None]
-
-    return source
+    Hinv = inverses(H)[None]
+    return lambda pts: homography_sources(Hinv, pts, rows)[0]
 
 
-def lens_source(
-    lens: Lens, C: NDArray, zoom: float, pts: NDArray, rows: NDArray | None = None
-) -> NDArray[np.float64]:
-    """Input pixels (M, 2) of output pixels under a lens: unproject with the zoomed lens,
-    turn by Cᵀ, project with the lens. ``C`` per knot row (B, 3, 3) with ``rows``: the
-    source row is found by the same fixed-point iteration as for homographies."""
-    rays = unproject(lens.zoomed(zoom), pts)
-    if rows is None:
-        return project(lens, rays @ C)
-    src = project(lens, rays @ C[len(rows) // 2])
-    for _ in range(ROW_ITERATIONS):
-        k, frac = _knot(src, rows)
-        Ck = C[k] + frac * (C[k + 1] - C[k])  # turns between knots are tiny: lerp is exact enough
-        src = project(lens, np.einsum("mj,mji->mi", rays, Ck))
-    return src
+def lens_source(lens: Lens, C: NDArray, zoom: float, rows: NDArray | None = None):
+    """The map output pixels (M, 2) → input pixels of one frame through a lens."""
+    C, zoom = np.asarray(C)[None], np.array([zoom])
+    return lambda pts: lens_sources(lens, C, zoom, pts, rows)[0]
 
 
 def warp_frame_lens(
     frame: NDArray[np.uint8], lens: Lens, C: NDArray, zoom: float, rows: NDArray | None = None
 ) -> NDArray[np.uint8]:
     """Undistort → rotate → redistort in one remap (see :mod:`stabilize.lens`)."""
-    return remap_from(frame, lambda pts: lens_source(lens, C, zoom, pts, rows))
+    return remap_from(frame, lens_source(lens, C, zoom, rows))
 
 
 def remap_from(frame: NDArray[np.uint8], source, fill: int = 0) -> NDArray[np.uint8]:

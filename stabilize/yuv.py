@@ -71,16 +71,11 @@ def warp(frame: NDArray[np.uint8], H: NDArray) -> NDArray[np.uint8]:
     return join(one(y, H, fill[0]), one(u, Hc, fill[1]), one(v, Hc, fill[2]))
 
 
-def remap(
-    frame: NDArray[np.uint8],
-    source: Callable[[NDArray], NDArray],
-    remap_plane: Callable[[NDArray, Callable[[NDArray], NDArray], int], NDArray],
-) -> NDArray[np.uint8]:
-    """Warp every plane by a map ``source`` (full-size output pixels → input pixels).
+def remap(frame: NDArray, source: Callable[[NDArray], NDArray]) -> NDArray:
+    """Warp every plane by a map ``source`` (full-size output pixels → input pixels);
+    chroma sees the same map through the half-size coordinates."""
+    from stabilize.warping import remap_from
 
-    ``remap_plane(plane, source, fill)`` warps one plane; chroma sees the same map
-    through the half-size coordinates.
-    """
     y, u, v = split(frame)
 
     def chroma_source(pts: NDArray) -> NDArray:
@@ -88,9 +83,9 @@ def remap(
 
     fill = black(frame)
     return join(
-        remap_plane(y, source, fill[0]),
-        remap_plane(u, chroma_source, fill[1]),
-        remap_plane(v, chroma_source, fill[2]),
+        remap_from(y, source, fill[0]),
+        remap_from(u, chroma_source, fill[1]),
+        remap_from(v, chroma_source, fill[2]),
     )
 
 

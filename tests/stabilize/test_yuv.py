@@ -6,7 +6,7 @@ import numpy as np
 from rotation import so3
 from rotation.camera import intrinsics
 from stabilize import yuv
-from stabilize.warping import homography, remap_from, rolling_source, warp_frame
+from stabilize.warping import homography, rolling_source, warp_frame
 
 
 def texture(h=120, w=160) -> np.ndarray:
@@ -37,9 +37,7 @@ def test_the_i420_warp_is_the_rgb_warp():
         assert np.abs(a[5:-5, 5:-5].astype(int) - b[5:-5, 5:-5]).mean() < 1.0
     # The generic map (rolling shutter, lens) warps the planes the same way.
     rows = np.linspace(-0.5, 119.5, 5)
-    mapped = yuv.remap(
-        yuv.from_rgb(rgb), rolling_source(np.repeat(H[None], 5, 0), rows), remap_from
-    )
+    mapped = yuv.remap(yuv.from_rgb(rgb), rolling_source(np.repeat(H[None], 5, 0), rows))
     assert np.abs(mapped.astype(int) - via_yuv).mean() < 0.3
 
 
