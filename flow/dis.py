@@ -26,6 +26,7 @@ class DISFlow:
     """
 
     name = "dis"
+    grey = True
 
     def __init__(self, preset: str = "fast") -> None:
         if preset not in PRESETS:

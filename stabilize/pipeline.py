@@ -171,7 +171,8 @@ def estimate_rotations(
     if len(times) < 2:
         raise VideoError(f"{path}: has {len(times)} frame(s); nothing to stabilise")
     ws = flow.working_size(info.size)
-    frames = read_frames(path, ws.size, info)
+    backend = flow.get(settings.flow, **settings.flow_options)
+    frames = read_frames(path, ws.size, info, "gray" if backend.grey else "rgb24")
     if lens is None:
         focal = settings.focal_px(info.width) * ws.scale[0]
         estimator = HoughEstimator(ws.size, focal, max_deg=settings.max_deg)
@@ -182,7 +183,6 @@ def estimate_rotations(
         maps = pinhole_map(replace(lens, K=K_ws), ws.size, focal, center)
         frames = (cv2.remap(f, *maps, cv2.INTER_LINEAR) for f in frames)
     sample_rows = estimator.grid.rows
-    backend = flow.get(settings.flow, **settings.flow_options)
     height = ws.size[0]
     edges = np.linspace(0, height, bands + 1).round().astype(int)
     found: list[list[tuple]] = [[] for _ in range(bands + 1)]  # whole frame, then bands
@@ -275,12 +275,15 @@ def plan(
     S = smooth_orientations(O, times, settings.smooth, settings.method)
     rows = None if rolling is None else rolling.rows
 
-    def corrections(path: NDArray) -> NDArray:
-        C = path @ np.swapaxes(O, -1, -2)
-        return C if rolling is None else C[:, None] @ np.swapaxes(rolling.turns, -1, -2)
+    def corrections(path: NDArray, frames: NDArray | slice = slice(None)) -> NDArray:
+        C = path @ np.swapaxes(O[frames], -1, -2)
+        if rolling is None:
+            return C
+        return C[:, None] @ np.swapaxes(rolling.turns[frames], -1, -2)
 
-    def zoom_of(path: NDArray) -> NDArray:
-        return required_zooms(K, corrections(path), size, settings.max_zoom * 1.001, rows, lens)
+    def zoom_of(path: NDArray, frames: NDArray) -> NDArray:
+        C = corrections(path, frames)
+        return required_zooms(K, C, size, settings.max_zoom * 1.001, rows, lens)
 
     if settings.crop == "none":
         need = np.ones(len(O))

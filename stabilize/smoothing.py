@@ -102,17 +102,19 @@ def respect_zoom_budget(
 ) -> tuple[NDArray, NDArray]:
     """Bend the smooth path where it would need more than max_zoom.
 
-    ``zoom_of(S)`` gives the zoom each frame needs. The path is bent towards each of
+    ``zoom_of(S, frames)`` gives the zoom that each of ``frames`` (indices) needs on the
+    path S (N, 3, 3). The path is bent towards each of
     ``via`` in turn (less smoothed paths: they still remove the fast shake and only
     follow the slower motion closer), and last towards the raw path O, which needs no
     zoom, so this ends. Returns (S, per-frame zoom).
     """
-    zoom = zoom_of(S)
+    everything = np.arange(len(S))
+    zoom = zoom_of(S, everything)
     for target in (*via, O):
         S, zoom = _bend(S, target, times, zoom_of, zoom, max_zoom, smooth)
         if not (zoom > max_zoom).any():
             return S, zoom
-    return O.copy(), zoom_of(O)
+    return O.copy(), zoom_of(O, everything)
 
 
 def _bend(
@@ -129,18 +131,25 @@ def _bend(
     amount = np.zeros(len(S))
     bent = S
     sigma = max(smooth, 1e-3) * PULL_SIGMA
-    g = np.exp(-0.5 * ((times[:, None] - times[None, :]) / sigma) ** 2)
+    dt = (times[:, None] - times[None, :]) / sigma
+    # Cut at 4σ, so that a round changes the path, and costs a zoom search, only near
+    # the frames over budget.
+    g = np.where(np.abs(dt) <= 4.0, np.exp(-0.5 * dt**2), 0.0)
     g /= g.sum(axis=1, keepdims=True)
     spread = np.zeros(len(S))
+    zoom = zoom.copy()
     for _ in range(PULL_ROUNDS):
         over = zoom > max_zoom
         if not over.any() or spread[over].min() >= 1.0:
             break
         # The pull grows where the budget is broken and is spread by a normalised
-        # Gaussian in time: smooth (no kinks that would read as jerks), and where it is
-        # too thin to help it keeps growing until it does.
-        amount += PULL_STEP * over
-        spread = np.clip(g @ amount, 0.0, 1.0)
+        # Gaussian in time: smooth (no kinks that would read as jerks). Each round adds
+        # about PULL_STEP of spread at every frame over budget, whether it is alone
+        # (where the Gaussian thins its pull out) or one of a run.
+        amount += PULL_STEP * over / np.maximum(g @ over, 1e-12)
+        grown = np.clip(g @ amount, 0.0, 1.0)
+        changed = np.flatnonzero(grown != spread)
+        spread = grown
         bent = blend(S, target, spread)
-        zoom = zoom_of(bent)
+        zoom[changed] = zoom_of(bent[changed], changed)
     return bent, zoom

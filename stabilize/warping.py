@@ -75,7 +75,8 @@ def homography_sources(
     ph = np.c_[pts, np.ones(len(pts))]
 
     def apply(H: NDArray) -> NDArray:
-        q = np.einsum("nmij,mj->nmi" if H.ndim == 4 else "nij,mj->nmi", H, ph)
+        # matmul, not einsum: numpy's einsum does not reach BLAS here (10× slower)
+        q = (H @ ph[:, :, None])[..., 0] if H.ndim == 4 else ph @ np.swapaxes(H, -1, -2)
         z = np.where(q[..., 2] > 1e-12, q[..., 2], np.nan)
         return q[..., :2] / z[..., None]
 

@@ -6,8 +6,12 @@ import pytest
 from rotation import so3
 from rotation.camera import intrinsics
 from stabilize.pipeline import Settings, choose_zoom, plan, repair_unreliable
-from stabilize.smoothing import orientations_from_rotations, smooth_orientations
-from stabilize.warping import covers, homography, required_zoom
+from stabilize.smoothing import (
+    orientations_from_rotations,
+    respect_zoom_budget,
+    smooth_orientations,
+)
+from stabilize.warping import covers, homography, required_zoom, required_zooms
 
 K = intrinsics(500.0, (360, 640))
 SIZE = (360, 640)
@@ -62,6 +66,29 @@ def test_the_zoom_budget_is_never_broken(crop):
     assert planned.zoom.max() <= 1.1 + 1e-9
     C = planned.smooth @ np.swapaxes(planned.raw, -1, -2)
     assert all(covers(K, c, z + 1e-6, SIZE) for c, z in zip(C, planned.zoom, strict=True))
+
+
+def test_one_jolt_bends_the_path_only_near_it_and_in_few_rounds():
+    # A steady 10 s path with one 4° jolt: only the frames within reach of the pull
+    # (4σ of it) may change, and an isolated frame must not need hundreds of rounds.
+    t = np.arange(300) / 30.0
+    angles = np.zeros((300, 3))
+    angles[150, 1] = np.radians(4.0)
+    O = so3.exp_so3(angles)
+    S = np.repeat(np.eye(3)[None], 300, axis=0)
+    searched = []
+
+    def zoom_of(path, frames):
+        searched.append(len(frames))
+        return required_zooms(K, path @ np.swapaxes(O[frames], -1, -2), SIZE, 1.2)
+
+    bent, zoom = respect_zoom_budget(O, S, t, zoom_of, 1.1, 0.5)
+    assert zoom.max() <= 1.1
+    assert len(searched) < 40
+    reach = 4 * 0.5 * 0.5 * 30  # 4σ of the pull, in frames
+    far = np.abs(np.arange(300) - 150) > reach + 1
+    assert np.array_equal(bent[far], S[far]) and not np.allclose(bent[150], S[150])
+    assert max(searched[1:]) <= 2 * reach + 3  # the later searches are local too
 
 
 def test_dynamic_zoom_is_smooth_and_never_below_the_need():
