@@ -9,6 +9,8 @@ the slow index, as in the official code; levels are concatenated finest first.
 
 from __future__ import annotations
 
+import math
+
 import torch
 import torch.nn.functional as F
 
@@ -18,13 +20,27 @@ def correlation_pyramid(
 ) -> list[torch.Tensor]:
     """Volumes of shape (B·h·w, 1, h / 2^l, w / 2^l), finest first."""
     b, d, h, w = fmap1.shape
-    corr = torch.matmul(fmap1.view(b, d, h * w).transpose(1, 2), fmap2.view(b, d, h * w))
-    corr = corr.view(b * h * w, 1, h, w) / torch.sqrt(torch.tensor(d).float())
+    f1 = fmap1.reshape(b, d, h * w).transpose(1, 2)
+    # The 1/√D scale rides on the matrix product instead of a pass over the volume.
+    empty = torch.empty(b, h * w, h * w, dtype=f1.dtype, device=f1.device)
+    corr = torch.baddbmm(empty, f1, fmap2.reshape(b, d, h * w), beta=0, alpha=1 / math.sqrt(d))
+    corr = corr.view(b * h * w, 1, h, w)
     pyramid = [corr]
     for _ in range(levels - 1):
-        corr = F.avg_pool2d(corr, 2, stride=2)
+        corr = pool2(corr)
         pyramid.append(corr)
     return pyramid
+
+
+def pool2(volume: torch.Tensor) -> torch.Tensor:
+    """avg_pool2d(volume, 2, stride=2) of (N, 1, H, W), an odd last row or column
+    dropped as there; written as a reshape, it is several times faster for a batch of
+    thousands of single-channel maps."""
+    n, _, h, w = volume.shape
+    v = volume[:, 0, : h // 2 * 2, : w // 2 * 2].reshape(n, 1, h // 2, 2, w // 2, 2)
+    return (
+        v[:, :, :, 0, :, 0] + v[:, :, :, 0, :, 1] + v[:, :, :, 1, :, 0] + v[:, :, :, 1, :, 1]
+    ) / 4
 
 
 def window(radius: int, device: torch.device) -> torch.Tensor:
