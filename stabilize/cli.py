@@ -13,7 +13,7 @@ import sys
 from dataclasses import replace
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
-from typing import NoReturn
+from typing import Annotated, NoReturn
 
 import numpy as np
 import typer
@@ -58,15 +58,99 @@ def _fail(message: str) -> NoReturn:
     raise typer.Exit(2)
 
 
-def _size(text: str) -> tuple[int, int]:
-    """'960x540' → (540, 960), i.e. (H, W)."""
-    try:
-        w, h = (int(v) for v in text.lower().split("x"))
-    except ValueError:
-        raise typer.BadParameter(f"expected WIDTHxHEIGHT, got {text!r}") from None
-    if w < 16 or h < 16:
-        raise typer.BadParameter(f"size {text} is too small")
-    return h, w
+# Options that several commands take, defined once (each command gives the default).
+FlowOption = Annotated[
+    str, typer.Option("--flow", help="Optical flow: dis (fast, CPU), raft or raft-large.")
+]
+RaftWeightsOption = Annotated[Path | None, typer.Option(help="RAFT checkpoint (.pth).")]
+DeviceOption = Annotated[str, typer.Option(help="cpu or cuda: RAFT flow and the frame warps.")]
+FovOption = Annotated[
+    float | None,
+    typer.Option(help="Horizontal field of view, deg (default 69: a phone's main camera)."),
+]
+FocalOption = Annotated[
+    float | None, typer.Option(help="Focal length in pixels (overrides --fov).")
+]
+LensOption = Annotated[
+    Path | None,
+    typer.Option(help="Gyroflow lens profile (.json, OpenCV fisheye): overrides --fov/--focal."),
+]
+SmoothOption = Annotated[float, typer.Option(min=0.01, help="Smoothing time constant, s.")]
+MethodOption = Annotated[str, typer.Option(help="adaptive (follows pans) or gaussian.")]
+LockOption = Annotated[bool, typer.Option(help="Hold one orientation, like a tripod.")]
+MaxZoomOption = Annotated[float, typer.Option(min=1.0, help="Never zoom in more than this.")]
+CropOption = Annotated[str, typer.Option(help="auto (one zoom), dynamic (smoothly varying), none.")]
+CodecOption = Annotated[str, typer.Option(help="libx264 or libx265.")]
+CrfOption = Annotated[int, typer.Option(min=0, max=51, help="Encoder quality (lower is better).")]
+PresetOption = Annotated[str, typer.Option(help="Encoder speed preset.")]
+PreviewOption = Annotated[
+    str, typer.Option(help="side-by-side: the original and the stabilised clip next to each other.")
+]
+SizeOption = Annotated[str | None, typer.Option(help="Output WIDTHxHEIGHT (default: the input's).")]
+GyroFormatOption = Annotated[str | None, typer.Option(help="Override the detected log format.")]
+GyroLpfOption = Annotated[float | None, typer.Option(help="Low-pass the gyro at this many Hz.")]
+GyroDriftOption = Annotated[bool, typer.Option("--gyro-drift", help="Also fit a clock drift.")]
+ReadoutOption = Annotated[
+    str | None,
+    typer.Option(
+        help="Rolling-shutter readout, ms, or 'auto' to estimate it (with a gyro log). "
+        "Default: the log's own value, else none."
+    ),
+]
+OverwriteOption = Annotated[bool, typer.Option(help="Replace the output if it exists.")]
+QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")]
+JsonOption = Annotated[bool, typer.Option("--json", help="Print the summary as JSON on stdout.")]
+
+
+def _job_settings(
+    *,
+    flow_name: str,
+    raft_weights: Path | None,
+    device: str,
+    fov: float | None,
+    focal: float | None,
+    lens: Path | None,
+    smooth: float,
+    method: str,
+    lock: bool,
+    max_zoom: float,
+    crop: str,
+    codec: str,
+    crf: int,
+    preset: str,
+    preview: str,
+    size: str | None,
+    readout_ms: str | None,
+    gyro_lpf: float | None,
+    gyro_drift: bool,
+    gyro: Path | str | None = None,
+    **gyro_options,
+):
+    """The pipeline's Settings from the options that ``run`` and ``batch`` share."""
+    from stabilize.video_writer import Encoding
+
+    if preview not in ("none", "side-by-side"):
+        _fail(f"--preview must be none or side-by-side, got {preview!r}")
+    return _settings(
+        flow_name,
+        raft_weights,
+        device,
+        fov=fov,
+        focal=focal,
+        smooth=smooth,
+        method="lock" if lock else method,
+        max_zoom=max_zoom,
+        crop=crop,
+        preview=preview == "side-by-side",
+        size=_output_size(size),
+        encoding=Encoding(codec=codec, crf=crf, preset=preset),
+        gyro=str(gyro) if gyro and gyro != "auto" else None,
+        gyro_lpf=gyro_lpf,
+        readout_ms=_readout(readout_ms, gyro),
+        gyro_drift=gyro_drift,
+        lens=str(lens) if lens else None,
+        **gyro_options,
+    )
 
 
 def _default_panorama() -> Path | None:
@@ -111,7 +195,7 @@ def synth(
     procedural: bool = typer.Option(
         False, help="Use the procedural skyline even if the photograph is present."
     ),
-    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar."),
+    quiet: QuietOption = False,
 ) -> None:
     """Render a shaky handheld street clip whose every rotation is known, with its gyro log."""
     from stabilize.progress import progress_bar
@@ -124,7 +208,7 @@ def synth(
         seed=seed,
         seconds=seconds,
         fps=fps,
-        size=_size(size),
+        size=_output_size(size),
         hfov=hfov,
         crowd=crowd,
         walls=walls,
@@ -223,7 +307,6 @@ def _settings(flow_name: str, raft_weights: Path | None, device: str, **options)
 
 
 FOCAL_ROUNDS = 3  # re-estimations when fitting the focal length to the gyro
-FLOW_HELP = "Optical flow: dis (fast, CPU), raft or raft-large (needs weights)."
 
 
 @app.command(
@@ -241,77 +324,67 @@ FLOW_HELP = "Optical flow: dis (fast, CPU), raft or raft-large (needs weights)."
 def run(
     input_path: Path = typer.Argument(..., metavar="IN", help="The shaky video."),
     output_path: Path = typer.Argument(..., metavar="OUT", help="Where to write the result."),
-    flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
-    raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
-    device: str = typer.Option("cpu", help="cpu or cuda: RAFT flow and the frame warps."),
-    fov: float | None = typer.Option(
-        None, help="Horizontal field of view, deg (default 69: a phone's main camera)."
-    ),
-    focal: float | None = typer.Option(None, help="Focal length in pixels (overrides --fov)."),
-    lens: Path | None = typer.Option(
-        None, help="Gyroflow lens profile (.json, OpenCV fisheye): overrides --fov/--focal."
-    ),
-    smooth: float = typer.Option(0.5, min=0.01, help="Smoothing time constant, s."),
-    method: str = typer.Option("adaptive", help="adaptive (follows pans) or gaussian."),
-    lock: bool = typer.Option(False, help="Hold one orientation, like a tripod."),
-    max_zoom: float = typer.Option(1.15, min=1.0, help="Never zoom in more than this."),
-    crop: str = typer.Option("auto", help="auto (one zoom), dynamic (smoothly varying), none."),
-    codec: str = typer.Option("libx264", help="libx264 or libx265."),
-    crf: int = typer.Option(18, min=0, max=51, help="Encoder quality (lower is better)."),
-    preset: str = typer.Option("medium", help="Encoder speed preset."),
+    flow_name: FlowOption = "dis",
+    raft_weights: RaftWeightsOption = None,
+    device: DeviceOption = "cpu",
+    fov: FovOption = None,
+    focal: FocalOption = None,
+    lens: LensOption = None,
+    smooth: SmoothOption = 0.5,
+    method: MethodOption = "adaptive",
+    lock: LockOption = False,
+    max_zoom: MaxZoomOption = 1.15,
+    crop: CropOption = "auto",
+    codec: CodecOption = "libx264",
+    crf: CrfOption = 18,
+    preset: PresetOption = "medium",
     report: Path | None = typer.Option(
         None, help="Write rotations.csv, path.csv, trajectory.png and summary.json here."
     ),
-    preview: str = typer.Option(
-        "none", help="side-by-side: the original and the stabilised clip next to each other."
-    ),
-    size: str | None = typer.Option(None, help="Output WIDTHxHEIGHT (default: the input's)."),
+    preview: PreviewOption = "none",
+    size: SizeOption = None,
     gyro: Path | None = typer.Option(
         None, help="Stabilise from this gyro log (synchronised to the video) instead."
     ),
-    gyro_format: str | None = typer.Option(None, help="Override the detected log format."),
+    gyro_format: GyroFormatOption = None,
     gyro_offset: float | None = typer.Option(None, help="Gyro minus video clock, s."),
     gyro_axes: str | None = typer.Option(None, help="IMU axis of camera x, y, z, e.g. YXz."),
-    gyro_lpf: float | None = typer.Option(None, help="Low-pass the gyro at this many Hz."),
-    gyro_drift: bool = typer.Option(False, "--gyro-drift", help="Also fit a clock drift."),
-    readout_ms: str | None = typer.Option(
-        None,
-        help="Rolling-shutter readout, ms, or 'auto' to estimate it (with --gyro). "
-        "Default: the log's own value, else none.",
-    ),
-    overwrite: bool = typer.Option(False, help="Replace OUT if it exists."),
-    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar."),
-    as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON on stdout."),
+    gyro_lpf: GyroLpfOption = None,
+    gyro_drift: GyroDriftOption = False,
+    readout_ms: ReadoutOption = None,
+    overwrite: OverwriteOption = False,
+    quiet: QuietOption = False,
+    as_json: JsonOption = False,
 ) -> None:
     """Stabilise a video: estimate each frame's rotation, smooth the path, warp, encode."""
     from stabilize.pipeline import stabilize_video
     from stabilize.progress import progress_bar
     from stabilize.video_reader import VideoError
-    from stabilize.video_writer import Encoding
 
-    if preview not in ("none", "side-by-side"):
-        _fail(f"--preview must be none or side-by-side, got {preview!r}")
-    settings = _settings(
-        flow_name,
-        raft_weights,
-        device,
+    settings = _job_settings(
+        flow_name=flow_name,
+        raft_weights=raft_weights,
+        device=device,
         fov=fov,
         focal=focal,
+        lens=lens,
         smooth=smooth,
-        method="lock" if lock else method,
+        method=method,
+        lock=lock,
         max_zoom=max_zoom,
         crop=crop,
-        preview=preview == "side-by-side",
-        size=_output_size(size),
-        encoding=Encoding(codec=codec, crf=crf, preset=preset),
-        gyro=str(gyro) if gyro else None,
+        codec=codec,
+        crf=crf,
+        preset=preset,
+        preview=preview,
+        size=size,
+        readout_ms=readout_ms,
+        gyro_lpf=gyro_lpf,
+        gyro_drift=gyro_drift,
+        gyro=gyro,
         gyro_format=gyro_format,
         gyro_offset=gyro_offset,
         gyro_axes=None if gyro_axes is None else tuple(map(tuple, _axes(gyro_axes))),
-        gyro_lpf=gyro_lpf,
-        readout_ms=_readout(readout_ms, gyro),
-        gyro_drift=gyro_drift,
-        lens=str(lens) if lens else None,
     )
     with contextlib.ExitStack() as stack:
 
@@ -354,13 +427,13 @@ def rotations(
     gcsv: Path | None = typer.Option(
         None, help="Also (or only) write the rates as a Gyroflow .gcsv, for clips with no gyro."
     ),
-    flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
-    raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
-    device: str = typer.Option("cpu", help="cpu or cuda: RAFT flow and the frame warps."),
-    fov: float | None = typer.Option(None, help="Horizontal field of view, deg (default 69)."),
-    focal: float | None = typer.Option(None, help="Focal length in pixels (overrides --fov)."),
-    overwrite: bool = typer.Option(False, help="Replace the output if it exists."),
-    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar."),
+    flow_name: FlowOption = "dis",
+    raft_weights: RaftWeightsOption = None,
+    device: DeviceOption = "cpu",
+    fov: FovOption = None,
+    focal: FocalOption = None,
+    overwrite: OverwriteOption = False,
+    quiet: QuietOption = False,
 ) -> None:
     """Estimate only: the camera rotation R_t of every frame pair (radians)."""
     from rotation import so3
@@ -441,17 +514,15 @@ def _axes(code: str | None):
 def compare(
     video: str = typer.Argument(..., help="A video, or an image pattern like dir/img-%d.jpg."),
     gyro: Path = typer.Option(..., help="The gyro log."),
-    gyro_format: str | None = typer.Option(None, help="Override the detected log format."),
+    gyro_format: GyroFormatOption = None,
     timestamps: Path | None = typer.Option(
         None, help="Frame times on the gyro clock (OpenCamera ns, or seconds per line)."
     ),
     start_number: int | None = typer.Option(None, help="First image number of a pattern."),
     fps: float | None = typer.Option(None, help="Frame rate of an image sequence."),
-    fov: float | None = typer.Option(None, help="Horizontal field of view, deg (default 69)."),
-    focal: float | None = typer.Option(None, help="Focal length in pixels (overrides --fov)."),
-    lens: Path | None = typer.Option(
-        None, help="Gyroflow lens profile (.json, OpenCV fisheye): overrides --fov/--focal."
-    ),
+    fov: FovOption = None,
+    focal: FocalOption = None,
+    lens: LensOption = None,
     offset: float | None = typer.Option(None, help="Gyro minus video clock, s (skip the search)."),
     axes: str | None = typer.Option(None, help="IMU axis of camera x, y, z, e.g. YXz."),
     search: float = typer.Option(1.0, min=0.0, help="Offset search range, ± seconds."),
@@ -466,11 +537,11 @@ def compare(
         "--calibrate-focal",
         help="Fit the focal length to the gyro (estimates the rotations again with it).",
     ),
-    flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
-    raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
+    flow_name: FlowOption = "dis",
+    raft_weights: RaftWeightsOption = None,
     report: Path | None = typer.Option(None, help="Write pairs.csv, summary.json and plots here."),
-    as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON on stdout."),
-    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar."),
+    as_json: JsonOption = False,
+    quiet: QuietOption = False,
 ) -> None:
     """Compare the visual rotation estimate with a gyroscope log."""
     from stabilize import compare as cmp
@@ -577,19 +648,27 @@ def batch(
     ray: str | None = typer.Option(
         None, help="Run on a Ray cluster: its address, or 'auto' (needs the 'cluster' extra)."
     ),
-    flow_name: str = typer.Option("dis", "--flow", help=FLOW_HELP),
-    raft_weights: Path | None = typer.Option(None, help="RAFT checkpoint (.pth)."),
-    fov: float | None = typer.Option(None, help="Horizontal field of view, deg (default 69)."),
-    focal: float | None = typer.Option(None, help="Focal length in pixels (overrides --fov)."),
-    smooth: float = typer.Option(0.5, min=0.01, help="Smoothing time constant, s."),
-    method: str = typer.Option("adaptive", help="adaptive or gaussian."),
-    lock: bool = typer.Option(False, help="Hold one orientation, like a tripod."),
-    max_zoom: float = typer.Option(1.15, min=1.0, help="Never zoom in more than this."),
-    crop: str = typer.Option("auto", help="auto, dynamic or none."),
-    codec: str = typer.Option("libx264", help="libx264 or libx265."),
-    crf: int = typer.Option(18, min=0, max=51, help="Encoder quality."),
-    preset: str = typer.Option("medium", help="Encoder speed preset."),
-    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar."),
+    flow_name: FlowOption = "dis",
+    raft_weights: RaftWeightsOption = None,
+    device: DeviceOption = "cpu",
+    fov: FovOption = None,
+    focal: FocalOption = None,
+    lens: LensOption = None,
+    smooth: SmoothOption = 0.5,
+    method: MethodOption = "adaptive",
+    lock: LockOption = False,
+    max_zoom: MaxZoomOption = 1.15,
+    crop: CropOption = "auto",
+    codec: CodecOption = "libx264",
+    crf: CrfOption = 18,
+    preset: PresetOption = "medium",
+    preview: PreviewOption = "none",
+    size: SizeOption = None,
+    gyro_format: GyroFormatOption = None,
+    gyro_lpf: GyroLpfOption = None,
+    gyro_drift: GyroDriftOption = False,
+    readout_ms: ReadoutOption = None,
+    quiet: QuietOption = False,
 ) -> None:
     """Stabilise every clip in a folder: resumable, one failure never stops the rest."""
     from rich.console import Console
@@ -597,23 +676,33 @@ def batch(
 
     from stabilize.batch import find_jobs, run_batch
     from stabilize.progress import batch_progress
-    from stabilize.video_writer import Encoding
 
     if not in_dir.is_dir():
         _fail(f"{in_dir}: not a folder")
     if gyro not in (None, "auto"):
         _fail("--gyro in batch mode takes 'auto' (a sidecar log per clip)")
-    settings = _settings(
-        flow_name,
-        raft_weights,
-        "cpu",
+    settings = _job_settings(
+        flow_name=flow_name,
+        raft_weights=raft_weights,
+        device=device,
         fov=fov,
         focal=focal,
+        lens=lens,
         smooth=smooth,
-        method="lock" if lock else method,
+        method=method,
+        lock=lock,
         max_zoom=max_zoom,
         crop=crop,
-        encoding=Encoding(codec=codec, crf=crf, preset=preset),
+        codec=codec,
+        crf=crf,
+        preset=preset,
+        preview=preview,
+        size=size,
+        readout_ms=readout_ms,
+        gyro_lpf=gyro_lpf,
+        gyro_drift=gyro_drift,
+        gyro=gyro,
+        gyro_format=gyro_format,
     )
     jobs = find_jobs(in_dir, out_dir, pattern, recursive, gyro_auto=gyro == "auto")
     if not jobs:

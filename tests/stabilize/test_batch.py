@@ -125,3 +125,26 @@ def test_frames_written_are_reported_from_every_worker(folder, tmp_path, workers
     frames, files = [], []
     run_batch(jobs, tmp_path / "out", Settings(), workers, files.append, on_frames=frames.append)
     assert len(files) == 2 and sum(frames) == 2 * 90
+
+
+def test_batch_takes_every_option_of_the_single_file_command():
+    import typer
+
+    commands = typer.main.get_command(app).commands
+    names = {name: {p.name for p in commands[name].params} for name in ("run", "batch")}
+    per_file = {"input_path", "output_path", "report", "overwrite", "as_json"}
+    per_clip_gyro = {"gyro_offset", "gyro_axes"}  # each clip's log has its own
+    assert names["run"] - per_file - per_clip_gyro <= names["batch"]
+
+
+def test_batch_passes_the_options_on(tmp_path):
+    from stabilize.video_reader import probe
+
+    src = tmp_path / "in"
+    src.mkdir()
+    (src / "a.mp4").write_bytes(SAMPLE.read_bytes())
+    out = tmp_path / "out"
+    args = ["batch", str(src), str(out), "--size", "320x180", "--crop", "none", "-q"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert probe(out / "a.mp4").size == (180, 320)
