@@ -8,6 +8,7 @@ that implements it. This module is only the shell: version, help and dispatch.
 from __future__ import annotations
 
 import contextlib
+import inspect
 import json
 import sys
 from dataclasses import replace
@@ -123,7 +124,8 @@ def _job_settings(
     readout_ms: str | None,
     gyro_lpf: float | None,
     gyro_drift: bool,
-    gyro: Path | str | None = None,
+    gyro: Path | str | None,
+    gyro_format: str | None,
     **gyro_options,
 ):
     """The pipeline's Settings from the options that ``run`` and ``batch`` share."""
@@ -149,8 +151,16 @@ def _job_settings(
         readout_ms=_readout(readout_ms, gyro),
         gyro_drift=gyro_drift,
         lens=str(lens) if lens else None,
+        gyro_format=gyro_format,
         **gyro_options,
     )
+
+
+def _shared(arguments: dict) -> dict:
+    """The options among a command's ``locals()`` that :func:`_job_settings` takes by name:
+    ``run`` and ``batch`` hand them on without listing them twice."""
+    names = inspect.signature(_job_settings).parameters
+    return {k: v for k, v in arguments.items() if k in names and k != "gyro_options"}
 
 
 def _default_panorama() -> Path | None:
@@ -361,31 +371,8 @@ def run(
     from stabilize.progress import progress_bar
     from stabilize.video_reader import VideoError
 
-    settings = _job_settings(
-        flow_name=flow_name,
-        raft_weights=raft_weights,
-        device=device,
-        fov=fov,
-        focal=focal,
-        lens=lens,
-        smooth=smooth,
-        method=method,
-        lock=lock,
-        max_zoom=max_zoom,
-        crop=crop,
-        codec=codec,
-        crf=crf,
-        preset=preset,
-        preview=preview,
-        size=size,
-        readout_ms=readout_ms,
-        gyro_lpf=gyro_lpf,
-        gyro_drift=gyro_drift,
-        gyro=gyro,
-        gyro_format=gyro_format,
-        gyro_offset=gyro_offset,
-        gyro_axes=None if gyro_axes is None else tuple(map(tuple, _axes(gyro_axes))),
-    )
+    axes = None if gyro_axes is None else tuple(map(tuple, _axes(gyro_axes)))
+    settings = _job_settings(**_shared(locals()), gyro_offset=gyro_offset, gyro_axes=axes)
     with contextlib.ExitStack() as stack:
 
         def bar(label: str, total: int | None):
@@ -681,29 +668,7 @@ def batch(
         _fail(f"{in_dir}: not a folder")
     if gyro not in (None, "auto"):
         _fail("--gyro in batch mode takes 'auto' (a sidecar log per clip)")
-    settings = _job_settings(
-        flow_name=flow_name,
-        raft_weights=raft_weights,
-        device=device,
-        fov=fov,
-        focal=focal,
-        lens=lens,
-        smooth=smooth,
-        method=method,
-        lock=lock,
-        max_zoom=max_zoom,
-        crop=crop,
-        codec=codec,
-        crf=crf,
-        preset=preset,
-        preview=preview,
-        size=size,
-        readout_ms=readout_ms,
-        gyro_lpf=gyro_lpf,
-        gyro_drift=gyro_drift,
-        gyro=gyro,
-        gyro_format=gyro_format,
-    )
+    settings = _job_settings(**_shared(locals()))
     jobs = find_jobs(in_dir, out_dir, pattern, recursive, gyro_auto=gyro == "auto")
     if not jobs:
         _fail(f"{in_dir}: no files match {pattern!r}")
