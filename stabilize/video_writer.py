@@ -81,7 +81,7 @@ class FrameWriter:
         if frame.shape != self.shape or frame.dtype != self.dtype:
             want = f"{np.dtype(self.dtype)} {self.shape}"
             raise ValueError(f"frame must be {want}, got {frame.dtype} {frame.shape}")
-        self._process.stdin.write(np.ascontiguousarray(frame).tobytes())
+        self._process.stdin.write(np.ascontiguousarray(frame))  # its buffer, not a copy
 
     def close(self) -> None:
         self._process.stdin.close()

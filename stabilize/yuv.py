@@ -60,15 +60,15 @@ def chroma_homography(H: NDArray) -> NDArray[np.float64]:
 
 def warp(frame: NDArray[np.uint8], H: NDArray) -> NDArray[np.uint8]:
     """cv2.warpPerspective of every plane by H (chroma by S H S⁻¹); black outside."""
-    y, u, v = split(frame)
     Hc = chroma_homography(H)
-    fill = black(frame)
-
-    def one(plane: NDArray, M: NDArray, fill: int) -> NDArray:
+    out = np.empty_like(frame)
+    # Each plane is warped straight into its place in the output: no joining copy.
+    for plane, dst, M, fill in zip(
+        split(frame), split(out), (H, Hc, Hc), black(frame), strict=True
+    ):
         size = (plane.shape[1], plane.shape[0])
-        return cv2.warpPerspective(plane, M, size, flags=cv2.INTER_LINEAR, borderValue=fill)
-
-    return join(one(y, H, fill[0]), one(u, Hc, fill[1]), one(v, Hc, fill[2]))
+        cv2.warpPerspective(plane, M, size, dst=dst, flags=cv2.INTER_LINEAR, borderValue=fill)
+    return out
 
 
 def remap(frame: NDArray, source: Callable[[NDArray], NDArray]) -> NDArray:
