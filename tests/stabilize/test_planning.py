@@ -163,3 +163,29 @@ def test_the_vectorised_zoom_search_finds_the_least_covering_zoom():
             assert covers(K, c, z, (180, 320)) and not covers(K, c, z - 1e-4, (180, 320))
             checked += 1
     assert checked >= 5
+
+
+def test_a_long_clip_plans_in_memory_that_grows_with_its_length_not_its_square():
+    import tracemalloc
+
+    n = 20_000  # 11 minutes at 30 fps: an (N, N) float matrix would take 3.2 GB
+    t = np.arange(n) / 30.0
+    angles = np.zeros((n, 3))
+    angles[::997, 1] = np.radians(4.0)  # a jolt every half minute
+    O = so3.exp_so3(angles)
+    S = np.repeat(np.eye(3)[None], n, axis=0)
+
+    def zoom_of(path, frames):  # 1 + the correction's angle: a cheap stand-in
+        return 1.0 + so3.angle(path @ np.swapaxes(O[frames], -1, -2))
+
+    need = np.ones(n)
+    need[::500] = 1.1
+    tracemalloc.start()
+    try:
+        z = choose_zoom(need, t, Settings(crop="dynamic", smooth=0.5, max_zoom=1.5))
+        _, zoom = respect_zoom_budget(O, S, t, zoom_of, 1.03, 0.5)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert np.all(z >= need) and zoom.max() <= 1.03
+    assert peak < 200e6, f"{peak / 1e6:.0f} MB"
