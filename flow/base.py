@@ -18,7 +18,6 @@ from numpy.typing import NDArray
 
 class FlowBackend(Protocol):
     name: str
-    grey: bool  # it only looks at luminance: grey frames spare a colour conversion
 
     def __call__(self, frame0: NDArray, frame1: NDArray) -> NDArray[np.float32]: ...
 

@@ -26,7 +26,6 @@ class DISFlow:
     """
 
     name = "dis"
-    grey = True
 
     def __init__(self, preset: str = "fast") -> None:
         if preset not in PRESETS:

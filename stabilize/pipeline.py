@@ -173,7 +173,7 @@ def estimate_rotations(
         raise VideoError(f"{path}: has {len(times)} frame(s); nothing to stabilise")
     ws = flow.working_size(info.size)
     backend = flow.get(settings.flow, **settings.flow_options)
-    frames = read_frames(path, ws.size, info, "gray" if backend.grey else "rgb24")
+    frames = read_frames(path, ws.size, info)
     if lens is None:
         focal = settings.focal_px(info.width) * ws.scale[0]
         estimator = HoughEstimator(ws.size, focal, max_deg=settings.max_deg)

@@ -25,8 +25,8 @@ from rotation import so3
 
 METHODS = ("adaptive", "gaussian", "lock")
 ADAPTIVE_REF_DEG_S = 30.0  # angular speed at which the window halves
-PULL_STEP = 0.05  # how much each round of respect_zoom_budget adds to an over-budget pull
-PULL_ROUNDS = 200
+PULL_STEP = 0.1  # how much each round of respect_zoom_budget adds to an over-budget pull
+PULL_ROUNDS = 400
 PULL_SIGMA = 0.5  # the pull's spread in time, as a share of the smoothing time constant
 
 
@@ -163,10 +163,9 @@ def _bend(
         if not over.any() or spread[over].min() >= 1.0:
             break
         # The pull grows where the budget is broken and is spread by a normalised
-        # Gaussian in time: smooth (no kinks that would read as jerks). Each round adds
-        # about PULL_STEP of spread at every frame over budget, whether it is alone
-        # (where the Gaussian thins its pull out) or one of a run.
-        amount += PULL_STEP * over / np.maximum(g @ over, 1e-12)
+        # Gaussian in time: smooth (no kinks that would read as jerks), and where it is
+        # too thin to help it keeps growing until it does.
+        amount += PULL_STEP * over
         grown = np.clip(g @ amount, 0.0, 1.0)
         changed = np.flatnonzero(grown != spread)
         spread = grown

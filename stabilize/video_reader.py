@@ -104,8 +104,8 @@ def read_frames(
     pix_fmt: str = "rgb24",
 ) -> Iterator[NDArray[np.uint8]]:
     """RGB uint8 frames (H, W, 3), streamed; resized to ``size`` (H, W) if given.
-    ``pix_fmt="yuv420p"`` gives I420 frames (3H/2, W) instead (:mod:`stabilize.yuv`),
-    ``"yuv420p10le"`` 10-bit ones (uint16), and ``"gray"`` luminance (H, W).
+    ``pix_fmt="yuv420p"`` gives I420 frames (3H/2, W) instead (:mod:`stabilize.yuv`), and
+    ``"yuv420p10le"`` 10-bit ones (uint16).
 
     FFmpeg applies the display rotation, so frames come upright. A stream that ends
     early or breaks raises :class:`VideoError` after the frames that did decode.
@@ -129,7 +129,7 @@ def read_frames(
     )
     widen_pipe(process.stdout)
     planar = pix_fmt.startswith("yuv420p")
-    shape = (h * 3 // 2, w) if planar else (h, w) if pix_fmt == "gray" else (h, w, 3)
+    shape = (h * 3 // 2, w) if planar else (h, w, 3)
     dtype = np.uint16 if pix_fmt.endswith("10le") else np.uint8
     frame_bytes = int(np.prod(shape)) * np.dtype(dtype).itemsize
     try:

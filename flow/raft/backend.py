@@ -66,7 +66,6 @@ class RaftFlow:
             raise ValueError(f"{path} holds RAFT-{found} weights, not RAFT-{variant}")
         self.variant = variant
         self.name = "raft" if variant == "small" else "raft-large"
-        self.grey = False
         self.iters = iters
         self.device = pick_device(device)
         self.batch_size = batch_size or (8 if self.device.type == "cuda" else 1)
