@@ -39,6 +39,7 @@ from stabilize.track import VisualTrack, mean_row
 from stabilize.video_reader import VideoError, VideoInfo, frame_times, probe, read_frames
 from stabilize.video_writer import Encoding, FrameWriter, is_variable_rate, retime
 from stabilize.warping import (
+    frames_covered,
     homography,
     lens_source,
     remap_from,
@@ -286,13 +287,17 @@ def plan(
         C = corrections(path, frames)
         return required_zooms(K, C, size, settings.max_zoom * 1.001, rows, lens)
 
+    def over(path: NDArray, frames: NDArray) -> NDArray:
+        zoom = np.full(len(frames), settings.max_zoom)
+        return ~frames_covered(K, corrections(path, frames), zoom, size, rows, lens)
+
     if settings.crop == "none":
         need = np.ones(len(O))
     else:
         # Where the budget binds, first give up only the slow part of the smoothing.
         looser = smooth_orientations(O, times, settings.smooth * LOOSER, settings.method)
         S, need = respect_zoom_budget(
-            O, S, times, zoom_of, settings.max_zoom, settings.smooth, via=(looser,)
+            O, S, times, zoom_of, settings.max_zoom, settings.smooth, via=(looser,), over=over
         )
     zoom = choose_zoom(need, times, settings)
     C = S @ np.swapaxes(O, -1, -2)

@@ -120,55 +120,60 @@ def respect_zoom_budget(
     max_zoom: float,
     smooth: float,
     via: Sequence[NDArray] = (),
+    over=None,
 ) -> tuple[NDArray, NDArray]:
     """Bend the smooth path where it would need more than max_zoom.
 
     ``zoom_of(S, frames)`` gives the zoom that each of ``frames`` (indices) needs on the
-    path S (N, 3, 3). The path is bent towards each of
-    ``via`` in turn (less smoothed paths: they still remove the fast shake and only
-    follow the slower motion closer), and last towards the raw path O, which needs no
-    zoom, so this ends. Returns (S, per-frame zoom).
+    path S (N, 3, 3); ``over(S, frames)``, whether each needs more than max_zoom (by
+    default from zoom_of; a direct check at max_zoom is much cheaper than a zoom
+    search). The path is bent towards each of ``via`` in turn (less smoothed paths:
+    they still remove the fast shake and only follow the slower motion closer), and
+    last towards the raw path O, which needs no zoom, so this ends. Returns (S,
+    per-frame zoom).
     """
     everything = np.arange(len(S))
+    if over is None:
+
+        def over(path: NDArray, frames: NDArray) -> NDArray:
+            return zoom_of(path, frames) > max_zoom
+
     zoom = zoom_of(S, everything)
     for target in (*via, O):
-        S, zoom = _bend(S, target, times, zoom_of, zoom, max_zoom, smooth)
         if not (zoom > max_zoom).any():
             return S, zoom
+        S = _bend(S, target, times, over, zoom > max_zoom, smooth)
+        zoom = zoom_of(S, everything)
+    if not (zoom > max_zoom).any():
+        return S, zoom
     return O.copy(), zoom_of(O, everything)
 
 
 def _bend(
-    S: NDArray,
-    target: NDArray,
-    times: NDArray,
-    zoom_of,
-    zoom: NDArray,
-    max_zoom: float,
-    smooth: float,
-) -> tuple[NDArray, NDArray]:
-    """Pull S towards ``target`` where the zoom is over budget, the pull itself smoothed
-    in time (so the path stays smooth), growing until no frame is over or it is full."""
+    S: NDArray, target: NDArray, times: NDArray, over, is_over: NDArray, smooth: float
+) -> NDArray:
+    """Pull S towards ``target`` where the zoom is over budget (``is_over``), the pull
+    itself smoothed in time (so the path stays smooth), growing until no frame is over
+    or it is full."""
     amount = np.zeros(len(S))
-    bent = S
+    bent = S.copy()
     sigma = max(smooth, 1e-3) * PULL_SIGMA
-    # Cut at 4σ, so that a round changes the path, and costs a zoom search, only near
-    # the frames over budget.
+    # Cut at 4σ, so that a round changes the path, and costs a check, only near the
+    # frames over budget.
     g = gaussian_band(times, sigma)
     g = sparse.diags_array(1.0 / g.sum(axis=1)) @ g
     spread = np.zeros(len(S))
-    zoom = zoom.copy()
+    is_over = is_over.copy()
     for _ in range(PULL_ROUNDS):
-        over = zoom > max_zoom
-        if not over.any() or spread[over].min() >= 1.0:
+        if not is_over.any() or spread[is_over].min() >= 1.0:
             break
         # The pull grows where the budget is broken and is spread by a normalised
         # Gaussian in time: smooth (no kinks that would read as jerks), and where it is
         # too thin to help it keeps growing until it does.
-        amount += PULL_STEP * over
+        amount += PULL_STEP * is_over
         grown = np.clip(g @ amount, 0.0, 1.0)
         changed = np.flatnonzero(grown != spread)
         spread = grown
-        bent = blend(S, target, spread)
-        zoom[changed] = zoom_of(bent[changed], changed)
-    return bent, zoom
+        bent[changed] = blend(S[changed], target[changed], spread[changed])
+        is_over[changed] = over(bent[changed], changed)
+    return bent

@@ -153,10 +153,19 @@ def covers(
     ``C`` is one correction, or one per knot row in ``rows`` (rolling shutter); with a
     ``lens`` the border is mapped through it instead of a homography.
     """
-    return bool(_covered(K, np.asarray(C)[None], np.array([zoom]), size, rows, lens)[0])
+    return bool(frames_covered(K, np.asarray(C)[None], np.array([zoom]), size, rows, lens)[0])
 
 
-def _covered(K, C, zoom, size, rows, lens) -> NDArray[np.bool_]:
+def frames_covered(
+    K: NDArray,
+    C: NDArray,
+    zoom: NDArray,
+    size: tuple[int, int],
+    rows: NDArray | None = None,
+    lens: Lens | None = None,
+) -> NDArray[np.bool_]:
+    """:func:`covers` for N frames at once: corrections C (N, 3, 3), or (N, B, 3, 3) at
+    knot ``rows``, zooms (N,)."""
     h, w = size
     xy = border_sources(K, C, zoom, size, rows, lens)
     x, y = xy[..., 0], xy[..., 1]
@@ -190,7 +199,7 @@ def required_zooms(
     C = np.asarray(C, dtype=np.float64)
 
     def covered(zoom: NDArray) -> NDArray[np.bool_]:
-        return _covered(K, C, zoom, size, rows, lens)
+        return frames_covered(K, C, zoom, size, rows, lens)
 
     lo, hi = np.ones(len(C)), np.full(len(C), float(max_zoom))
     done = covered(lo)
