@@ -25,8 +25,8 @@ from rotation import so3
 
 METHODS = ("adaptive", "gaussian", "lock")
 ADAPTIVE_REF_DEG_S = 30.0  # angular speed at which the window halves
-PULL_STEP = 0.1  # how much each round of respect_zoom_budget adds to an over-budget pull
-PULL_ROUNDS = 400
+PULL_STEP = 0.05  # how much each round of respect_zoom_budget adds to an over-budget pull
+PULL_ROUNDS = 800
 PULL_SIGMA = 0.5  # the pull's spread in time, as a share of the smoothing time constant
 
 
