@@ -44,6 +44,7 @@ from stabilize.warping import (
     lens_source,
     remap_from,
     required_zooms,
+    resize_image,
     rolling_source,
     warp_frame,
     warp_frames_torch,
@@ -349,7 +350,7 @@ def render(
     if pix_fmt == "yuv420p10le" and encoding.pix_fmt == "yuv420p":
         encoding = replace(encoding, pix_fmt=pix_fmt)  # keep a 10-bit source's depth
     side_by_side = yuv.hstack if planar else lambda a, b: np.hstack([a, b])
-    resize = yuv.resize if planar else resize_rgb
+    resize = yuv.resize if planar else resize_image
     try:
         with FrameWriter(
             target, size, fps, encoding, audio, copy_audio=True, pix_fmt_in=pix_fmt
@@ -371,13 +372,6 @@ def render(
         if variable:
             target.unlink(missing_ok=True)
     return written
-
-
-def resize_rgb(frame: NDArray[np.uint8], size: tuple[int, int]) -> NDArray[np.uint8]:
-    """An RGB frame at (H, W): area averaging to shrink, bilinear to grow."""
-    h, w = size
-    shrink = h * w < frame.shape[0] * frame.shape[1]
-    return cv2.resize(frame, (w, h), interpolation=cv2.INTER_AREA if shrink else cv2.INTER_LINEAR)
 
 
 def batches(items: Iterable, n: int) -> Iterator[list]:

@@ -140,13 +140,12 @@ def respect_zoom_budget(
 
     zoom = zoom_of(S, everything)
     for target in (*via, O):
-        if not (zoom > max_zoom).any():
-            return S, zoom
-        S = _bend(S, target, times, over, zoom > max_zoom, smooth)
-        zoom = zoom_of(S, everything)
-    if not (zoom > max_zoom).any():
-        return S, zoom
-    return O.copy(), zoom_of(O, everything)
+        if (zoom > max_zoom).any():
+            S = _bend(S, target, times, over, zoom > max_zoom, smooth)
+            zoom = zoom_of(S, everything)
+    if (zoom > max_zoom).any():  # the rounds ran out before the raw path was reached
+        return O.copy(), zoom_of(O, everything)
+    return S, zoom
 
 
 def _bend(

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stabilize.ffmpeg_tools import ffmpeg_exe, widen_pipe
+from stabilize.yuv import pipe_layout
 
 
 class VideoError(ValueError):
@@ -128,9 +129,7 @@ def read_frames(
         .run_async(cmd=ffmpeg_exe(), pipe_stdout=True, pipe_stderr=True)
     )
     widen_pipe(process.stdout)
-    planar = pix_fmt.startswith("yuv420p")
-    shape = (h * 3 // 2, w) if planar else (h, w, 3)
-    dtype = np.uint16 if pix_fmt.endswith("10le") else np.uint8
+    shape, dtype = pipe_layout(pix_fmt, (h, w))
     frame_bytes = int(np.prod(shape)) * np.dtype(dtype).itemsize
     try:
         while True:

@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stabilize.ffmpeg_tools import ffmpeg_exe, widen_pipe
+from stabilize.yuv import pipe_layout
 
 TIMESCALE = 90_000  # ticks per second of retimed video (MPEG's clock)
 
@@ -47,8 +48,7 @@ class FrameWriter:
     ) -> None:
         encoding = encoding or Encoding()
         h, w = size
-        self.shape = (h * 3 // 2, w) if pix_fmt_in.startswith("yuv420p") else (h, w, 3)
-        self.dtype = np.uint16 if pix_fmt_in.endswith("10le") else np.uint8
+        self.shape, self.dtype = pipe_layout(pix_fmt_in, size)
         video = ffmpeg.input(
             "pipe:", format="rawvideo", pix_fmt=pix_fmt_in, s=f"{w}x{h}", framerate=fps
         )

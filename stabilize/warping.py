@@ -97,7 +97,9 @@ def lens_sources(
     rays = unproject(lens, scaled.reshape(-1, 2)).reshape(n, m, 3)
 
     def apply(Cp: NDArray) -> NDArray:
-        turned = np.einsum("nmj,nmji->nmi" if Cp.ndim == 4 else "nmj,nji->nmi", rays, Cp)
+        # Row vectors times C (one per frame, or per point): matmul, as in
+        # homography_sources, since einsum does not reach BLAS here.
+        turned = (rays[..., None, :] @ Cp)[..., 0, :] if Cp.ndim == 4 else rays @ Cp
         return project(lens, turned.reshape(-1, 3)).reshape(n, m, 2)
 
     return _through_rows(C, rows, apply)
@@ -210,6 +212,13 @@ def required_zooms(
         hi = np.where(fits, mid, hi)
         lo = np.where(fits, lo, mid)
     return np.where(done, 1.0, np.where(hopeless, np.inf, hi))
+
+
+def resize_image(image: NDArray, size: tuple[int, int]) -> NDArray:
+    """An image (or one plane) at (H, W): area averaging to shrink, bilinear to grow."""
+    h, w = size
+    shrink = h * w < image.shape[0] * image.shape[1]
+    return cv2.resize(image, (w, h), interpolation=cv2.INTER_AREA if shrink else cv2.INTER_LINEAR)
 
 
 def warp_frame(frame: NDArray[np.uint8], H: NDArray) -> NDArray[np.uint8]:

@@ -19,8 +19,9 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from stabilize.warping import remap_from, resize_image
+
 BLACK = (16, 128, 128)  # limited-range black: Y, U, V (8 bits; ×4 at 10 bits)
-FORMATS = {"yuv420p": np.uint8, "yuv420p10le": np.uint16}  # pipe format → sample type
 HALF = np.array([[0.5, 0.0, -0.25], [0.0, 0.5, -0.25], [0.0, 0.0, 1.0]])  # S above
 
 
@@ -33,6 +34,15 @@ def black(frame: NDArray) -> tuple[int, int, int]:
 def pipe_format(source_pix_fmt: str) -> str:
     """The I420 pipe format that keeps a source's depth: 10 bits stay 10 bits."""
     return "yuv420p10le" if "10" in source_pix_fmt else "yuv420p"
+
+
+def pipe_layout(pix_fmt: str, size: tuple[int, int]) -> tuple[tuple[int, ...], type]:
+    """(shape, dtype) of one raw frame of (H, W) pixels in FFmpeg's ``pix_fmt``: I420
+    (3H/2, W), 8 or 10 bits (``yuv420p10le``: uint16), else RGB (H, W, 3) uint8."""
+    h, w = size
+    if pix_fmt.startswith("yuv420p"):
+        return (h * 3 // 2, w), np.uint16 if pix_fmt.endswith("10le") else np.uint8
+    return (h, w, 3), np.uint8
 
 
 def supports(size: tuple[int, int]) -> bool:
@@ -74,8 +84,6 @@ def warp(frame: NDArray[np.uint8], H: NDArray) -> NDArray[np.uint8]:
 def remap(frame: NDArray, source: Callable[[NDArray], NDArray]) -> NDArray:
     """Warp every plane by a map ``source`` (full-size output pixels → input pixels);
     chroma sees the same map through the half-size coordinates."""
-    from stabilize.warping import remap_from
-
     y, u, v = split(frame)
 
     def chroma_source(pts: NDArray) -> NDArray:
@@ -93,13 +101,8 @@ def resize(frame: NDArray[np.uint8], size: tuple[int, int]) -> NDArray[np.uint8]
     """An I420 frame at (H, W) (both even): every plane resized alike."""
     h, w = size
     y, u, v = split(frame)
-    shrink = h * w < y.size
-    mode = cv2.INTER_AREA if shrink else cv2.INTER_LINEAR
-    return join(
-        cv2.resize(y, (w, h), interpolation=mode),
-        cv2.resize(u, (w // 2, h // 2), interpolation=mode),
-        cv2.resize(v, (w // 2, h // 2), interpolation=mode),
-    )
+    half = (h // 2, w // 2)
+    return join(resize_image(y, size), resize_image(u, half), resize_image(v, half))
 
 
 def hstack(a: NDArray[np.uint8], b: NDArray[np.uint8]) -> NDArray[np.uint8]:
