@@ -159,8 +159,9 @@ def _job_settings(
 def _shared(arguments: dict) -> dict:
     """The options among a command's ``locals()`` that :func:`_job_settings` takes by name:
     ``run`` and ``batch`` hand them on without listing them twice."""
-    names = inspect.signature(_job_settings).parameters
-    return {k: v for k, v in arguments.items() if k in names and k != "gyro_options"}
+    params = inspect.signature(_job_settings).parameters.values()
+    names = {p.name for p in params if p.kind is p.KEYWORD_ONLY}
+    return {k: v for k, v in arguments.items() if k in names}
 
 
 def _default_panorama() -> Path | None:
