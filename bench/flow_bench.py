@@ -6,6 +6,9 @@ walking translation, with walking people. For each backend it prints the median 
 per pair when streaming frames (``backend.many``), the mean endpoint error (EPE) over
 all pixels with ground truth, the mean angular error of ``rotation.HoughEstimator`` on
 that flow against the true R_t, and the peak memory of the process that ran it.
+With RAFT weights it also prints RAFT-small's arithmetic per pair and the time that
+arithmetic alone takes at this machine's float32 matrix-product peak: the floor under
+any exact (float32, direct-convolution) implementation here.
 
     python bench/flow_bench.py                       # DIS presets, RAFT if weights found
     python bench/flow_bench.py --raft-weights ../shared/raft/raft-small.pth
@@ -76,6 +79,38 @@ def exact_flow_rotation_error(n_frames: int, seeds: list[int]) -> float:
     return float(np.mean(errs))
 
 
+def raft_gflop_per_pair(weights: str | os.PathLike, iters: int = 12) -> float:
+    """GFLOP (multiply-adds ×2) of one streamed pair: one frame's features and context,
+    the correlation volume and ``iters`` updates, counted by torch's FlopCounterMode."""
+    import torch
+    from torch.utils.flop_counter import FlopCounterMode
+
+    from flow.raft.backend import RaftFlow
+
+    model = RaftFlow("small", weights=weights, iters=iters, device="cpu").model
+    images = torch.rand(2, 3, 272, 480) * 255
+    with torch.inference_mode():
+        next_features = model.features(images[1:])  # the next pair's share
+        with FlopCounterMode(display=False) as counter:
+            features = model.features(images[:1])
+            net, inp = model.context(images[:1])
+            model.iterate(features, next_features, net, inp, iters)
+    return counter.get_total_flops() / 1e9
+
+
+def matmul_peak_gflops(n: int = 2048, repeats: int = 10) -> float:
+    """float32 GFLOP/s of an n×n matrix product on all threads: the machine's practical peak."""
+    import torch
+
+    a, b = torch.randn(n, n), torch.randn(n, n)
+    for _ in range(3):
+        a @ b
+    t0 = time.perf_counter()
+    for _ in range(repeats):
+        a @ b
+    return 2 * n**3 * repeats / (time.perf_counter() - t0) / 1e9
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=16, help="frames per clip")
@@ -115,6 +150,12 @@ def main() -> None:
         f"{'exact flow (reference)':28s}{'':10s}{0.0:10.3f}"
         f"{exact_flow_rotation_error(args.frames, seeds):12.4f}"
     )
+    if weights:
+        gflop, peak = raft_gflop_per_pair(weights), matmul_peak_gflops()
+        print(
+            f"RAFT-small, 12 iterations: {gflop:.1f} GFLOP per pair; float32 matmul peak here "
+            f"{peak:.0f} GFLOP/s, so the arithmetic alone takes {1e3 * gflop / peak:.0f} ms"
+        )
 
 
 if __name__ == "__main__":
