@@ -85,10 +85,11 @@ def raft_gflop_per_pair(weights: str | os.PathLike, iters: int = 12) -> float:
     import torch
     from torch.utils.flop_counter import FlopCounterMode
 
-    from flow.raft.backend import RaftFlow
+    from flow.raft.backend import RaftFlow, padding
 
     model = RaftFlow("small", weights=weights, iters=iters, device="cpu").model
-    images = torch.rand(2, 3, 272, 480) * 255
+    left, right, top, bottom = padding(*SIZE)
+    images = torch.rand(2, 3, SIZE[0] + top + bottom, SIZE[1] + left + right) * 255
     with torch.inference_mode():
         next_features = model.features(images[1:])  # the next pair's share
         with FlopCounterMode(display=False) as counter:

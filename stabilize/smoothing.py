@@ -15,7 +15,7 @@ holds one orientation, as on a tripod.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,6 +28,10 @@ ADAPTIVE_REF_DEG_S = 30.0  # angular speed at which the window halves
 PULL_STEP = 0.05  # how much each round of respect_zoom_budget adds to an over-budget pull
 PULL_ROUNDS = 800
 PULL_SIGMA = 0.5  # the pull's spread in time, as a share of the smoothing time constant
+
+# f(path, frames): a per-frame figure (the zoom needed, or whether it is over budget) for
+# the frames (indices) of a path (N, 3, 3).
+PerFrame = Callable[[NDArray, NDArray], NDArray]
 
 
 def gaussian_band(times: NDArray, sigma: float, reach: float = 4.0) -> sparse.csr_array:
@@ -116,11 +120,11 @@ def respect_zoom_budget(
     O: NDArray,
     S: NDArray,
     times: NDArray,
-    zoom_of,
+    zoom_of: PerFrame,
     max_zoom: float,
     smooth: float,
     via: Sequence[NDArray] = (),
-    over=None,
+    over: PerFrame | None = None,
 ) -> tuple[NDArray, NDArray]:
     """Bend the smooth path where it would need more than max_zoom.
 
@@ -149,7 +153,7 @@ def respect_zoom_budget(
 
 
 def _bend(
-    S: NDArray, target: NDArray, times: NDArray, over, is_over: NDArray, smooth: float
+    S: NDArray, target: NDArray, times: NDArray, over: PerFrame, is_over: NDArray, smooth: float
 ) -> NDArray:
     """Pull S towards ``target`` where the zoom is over budget (``is_over``), the pull
     itself smoothed in time (so the path stays smooth), growing until no frame is over
