@@ -28,9 +28,8 @@ from pathlib import Path
 import numpy as np
 
 from rotation import so3
-from stabilize.ffmpeg_tools import ffmpeg_exe
-from stabilize.metrics import evaluate_pair
-from stabilize.video_reader import probe, read_frames
+from stabilize.evaluate.metrics import evaluate_pair
+from stabilize.video import ffmpeg_exe, probe, read_frames
 
 ENCODER = ["-c:v", "libx264", "-crf", "18", "-preset", "medium", "-pix_fmt", "yuv420p"]
 

@@ -11,11 +11,28 @@ working size with :func:`flow.working_size` (about 480 px on the long side).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from flow.base import FlowBackend
 from flow.dis import DISFlow
 from flow.resize import WorkingSize, working_size
 
-BACKENDS = ("dis", "raft", "raft-large")
+
+def _raft(variant: str) -> Callable[..., FlowBackend]:
+    def make(**options) -> FlowBackend:
+        from flow.raft import RaftFlow  # torch is imported only when RAFT is asked for
+
+        return RaftFlow(variant, **options)
+
+    return make
+
+
+# The registry: a backend's name → its factory. Adding one is one line here.
+BACKENDS: dict[str, Callable[..., FlowBackend]] = {
+    "dis": DISFlow,
+    "raft": _raft("small"),
+    "raft-large": _raft("large"),
+}
 
 
 def get(name: str = "dis", **options) -> FlowBackend:
@@ -24,13 +41,9 @@ def get(name: str = "dis", **options) -> FlowBackend:
     Options go to the backend: ``preset`` for DIS; ``weights``, ``iters``, ``device``
     and ``batch_size`` for RAFT (:class:`flow.raft.RaftFlow`).
     """
-    if name == "dis":
-        return DISFlow(**options)
-    if name in ("raft", "raft-large"):
-        from flow.raft import RaftFlow  # torch is imported only when RAFT is asked for
-
-        return RaftFlow("small" if name == "raft" else "large", **options)
-    raise ValueError(f"unknown flow backend {name!r}; choose from {', '.join(BACKENDS)}")
+    if name not in BACKENDS:
+        raise ValueError(f"unknown flow backend {name!r}; choose from {', '.join(BACKENDS)}")
+    return BACKENDS[name](**options)
 
 
 __all__ = ["BACKENDS", "DISFlow", "FlowBackend", "WorkingSize", "get", "working_size"]

@@ -41,7 +41,7 @@ from numpy.typing import NDArray
 
 from rotation.camera import default_center
 from rotation.models import lh_line, perspective_curve
-from rotation.refine import exp_so3, refine
+from rotation.refine import refine, rodrigues, rotate_ray
 from rotation.result import RotationEstimate
 from rotation.sampling import check_flows, sample_flows, sample_grid
 from rotation.voting import (
@@ -132,17 +132,7 @@ class HoughEstimator:
         u, v, valid = sample_flows(flow, self.grid)
         with self._lock:
             R, count, inliers = estimate_field(
-                self.grid.x,
-                self.grid.y,
-                u,
-                v,
-                valid,
-                self.focal,
-                self.levels,
-                self._model_code,
-                self.refine,
-                self._acc,
-                self._touched,
+                *self._field_args(u, v, valid), self._acc, self._touched
             )
         return self._result(R, count, inliers, valid)
 
@@ -151,20 +141,17 @@ class HoughEstimator:
         flows = check_flows(flows, self.size, stacked=True)
         u, v, valid = sample_flows(flows, self.grid)
         Rs, counts, inliers = estimate_batch(
-            self.grid.x,
-            self.grid.y,
-            u,
-            v,
-            valid,
-            self.focal,
-            self.levels,
-            self._model_code,
-            self.refine,
+            *self._field_args(u, v, valid),
             self._n_max,
             self._touched_len,
             min(len(u), 2 * get_num_threads()),
         )
         return [self._result(*item) for item in zip(Rs, counts, inliers, valid, strict=True)]
+
+    def _field_args(self, u: NDArray, v: NDArray, valid: NDArray) -> tuple:
+        """The kernels' leading arguments: samples, flow, focal length, search, model."""
+        x, y = self.grid.x, self.grid.y
+        return x, y, u, v, valid, self.focal, self.levels, self._model_code, self.refine
 
     def _result(self, R: NDArray, count: int, inliers: NDArray, valid: NDArray) -> RotationEstimate:
         n_valid = int(valid.sum())
@@ -228,7 +215,7 @@ def estimate_field(x, y, u, v, valid, f, levels, model, do_refine, acc, touched)
         else:
             inliers = curve_inliers(xp, yp, qx, qy, valid, f, s, half, n, b)
         count = int(inliers.sum())
-        R = exp_so3(-bin_center(b, n, s)) @ R
+        R = rodrigues(-bin_center(b, n, s)) @ R
     if do_refine:
         R = refine(x, y, qx, qy, f, R, valid, REFINE_GATE_BINS * f * levels[-1, 0])
     return R, count, inliers
@@ -238,9 +225,7 @@ def estimate_field(x, y, u, v, valid, f, levels, model, do_refine, acc, touched)
 def derotate(x, y, f, R, xp, yp) -> None:
     """Where each sample lands under R alone: π(R (x, y, f)), written into xp, yp."""
     for i in range(x.shape[0]):
-        X0 = R[0, 0] * x[i] + R[0, 1] * y[i] + R[0, 2] * f
-        X1 = R[1, 0] * x[i] + R[1, 1] * y[i] + R[1, 2] * f
-        X2 = R[2, 0] * x[i] + R[2, 1] * y[i] + R[2, 2] * f
+        X0, X1, X2 = rotate_ray(R, x[i], y[i], f)
         X2 = max(X2, 1e-9)
         xp[i] = f * X0 / X2
         yp[i] = f * X1 / X2

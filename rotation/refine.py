@@ -25,8 +25,9 @@ MIN_SCALE_PX = 0.1  # noise-free flow must not shrink the scale to nothing
 
 
 @njit(cache=True)
-def exp_so3(w: np.ndarray) -> np.ndarray:
-    """Rodrigues' formula for one rotation vector."""
+def rodrigues(w: np.ndarray) -> np.ndarray:
+    """exp([w]×) for one rotation vector, by Rodrigues' formula (the kernels' own copy of
+    :func:`rotation.so3.exp_so3`, which works on stacks in numpy)."""
     theta = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
     k = np.zeros((3, 3))
     k[0, 1], k[0, 2], k[1, 0] = -w[2], w[1], w[2]
@@ -40,6 +41,15 @@ def exp_so3(w: np.ndarray) -> np.ndarray:
     return np.eye(3) + a * k + b * (k @ k)
 
 
+@njit(cache=True, inline="always")
+def rotate_ray(R: np.ndarray, x: float, y: float, f: float) -> tuple:
+    """R (x, y, f): the ray of pixel (x, y) (relative to the principal point) turned by R."""
+    X0 = R[0, 0] * x + R[0, 1] * y + R[0, 2] * f
+    X1 = R[1, 0] * x + R[1, 1] * y + R[1, 2] * f
+    X2 = R[2, 0] * x + R[2, 1] * y + R[2, 2] * f
+    return X0, X1, X2
+
+
 @njit(cache=True)
 def residuals(x, y, qx, qy, f, R, valid) -> np.ndarray:
     """|q̂ᵢ - qᵢ| in pixels for each vector (inf where invalid or behind the camera)."""
@@ -47,9 +57,7 @@ def residuals(x, y, qx, qy, f, R, valid) -> np.ndarray:
     for i in range(x.shape[0]):
         if not valid[i]:
             continue
-        X0 = R[0, 0] * x[i] + R[0, 1] * y[i] + R[0, 2] * f
-        X1 = R[1, 0] * x[i] + R[1, 1] * y[i] + R[1, 2] * f
-        X2 = R[2, 0] * x[i] + R[2, 1] * y[i] + R[2, 2] * f
+        X0, X1, X2 = rotate_ray(R, x[i], y[i], f)
         if X2 > 1e-9:
             out[i] = math.hypot(f * X0 / X2 - qx[i], f * X1 / X2 - qy[i])
     return out
@@ -64,9 +72,7 @@ def gauss_newton_step(x, y, qx, qy, f, R, w) -> np.ndarray:
     for i in range(x.shape[0]):
         if w[i] <= 0.0:
             continue
-        X0 = R[0, 0] * x[i] + R[0, 1] * y[i] + R[0, 2] * f
-        X1 = R[1, 0] * x[i] + R[1, 1] * y[i] + R[1, 2] * f
-        X2 = R[2, 0] * x[i] + R[2, 1] * y[i] + R[2, 2] * f
+        X0, X1, X2 = rotate_ray(R, x[i], y[i], f)
         if X2 <= 1e-9:
             continue
         iz = 1.0 / X2
@@ -96,7 +102,7 @@ def fit(x, y, qx, qy, f, R, w, iters: int) -> np.ndarray:
     """Gauss-Newton with fixed weights."""
     for _ in range(iters):
         delta = gauss_newton_step(x, y, qx, qy, f, R, w)
-        R = exp_so3(delta) @ R
+        R = rodrigues(delta) @ R
         if math.sqrt(delta @ delta) < 1e-12:
             break
     return R

@@ -20,7 +20,7 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from stabilize.ffmpeg_tools import atomic_output
+from stabilize.video import atomic_output
 
 MANIFEST = "manifest.json"
 GYRO_SIDECARS = (".gcsv", ".csv", ".txt")

@@ -17,7 +17,7 @@ import numpy as np
 
 from stabilize.gyro.log import GyroError, GyroLog
 from stabilize.gyro.sync import IntervalRates, Sync, visual_rates
-from stabilize.track import VisualTrack
+from stabilize.motion.track import VisualTrack
 
 
 def focal_from_gyro(track: VisualTrack, log: GyroLog, sync: Sync, focal: float) -> float:

@@ -19,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
+from stabilize.gyro.axes import axes_matrix
 from stabilize.gyro.log import GyroError, GyroLog
 
-FORMATS = ("opencamera", "phone-cc9", "gcsv", "sensorlogger", "csv", "telemetry")
 VIDEO_SUFFIXES = {".mp4", ".mov", ".insv", ".360", ".mxf", ".mkv", ".braw", ".lrv", ".m4v"}
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 RATE_UNITS = {"rad/s": 1.0, "deg/s": np.pi / 180.0}
@@ -76,6 +76,18 @@ def read_frame_timestamps_s(path: str | Path) -> np.ndarray:
     return _frame_times(Path(path), 1.0)
 
 
+def sensor_frame_times(path: str | Path, first: int, count: int) -> np.ndarray:
+    """``count`` frame times (s, on the sensor's clock) from line ``first`` (0-based) of a
+    timestamps file: seconds per line (phone-cc9), or integer nanoseconds (OpenCamera)."""
+    stamps = read_frame_timestamps_s(path)
+    if stamps[0] > 1e12:  # integer nanoseconds (OpenCamera), not seconds
+        stamps = stamps * 1e-9
+    times = stamps[first : first + count]
+    if len(times) < count:
+        raise GyroError(f"{path}: {len(stamps)} frame times, the video needs {first + count}")
+    return times
+
+
 def _frame_times(path: Path, scale: float) -> np.ndarray:
     data = np.array(_rows(path, 1))[:, 0] * scale
     if np.any(np.diff(data) <= 0):
@@ -119,7 +131,11 @@ def read_gcsv(path: str | Path) -> GyroLog:
     idx = [columns.index(c) for c in ("t", "gx", "gy", "gz")]
     data = np.array(_rows(path, len(columns), start=start))[:, idx]
     rates = data[:, 1:] * gscale
-    rates = rates @ orientation_matrix(header.get("orientation", "XYZ"), path).T
+    try:  # the code names the sensor axis of each column: the transpose of axes_matrix
+        columns_to_sensor = axes_matrix(header.get("orientation", "XYZ"), proper=False).T
+    except GyroError:
+        raise GyroError(f"{path}: orientation must be a signed permutation of XYZ") from None
+    rates = rates @ columns_to_sensor.T
     readout = header.get("frame_readout_time")
     try:
         readout_s = float(readout) / 1000.0 if readout else None  # logged in ms
@@ -128,16 +144,6 @@ def read_gcsv(path: str | Path) -> GyroLog:
     if readout_s is not None and header.get("frame_readout_direction", "0") not in ("0", ""):
         readout_s = None  # only top-to-bottom readout is modelled
     return GyroLog(data[:, 0] * tscale, rates, str(path), readout_s)
-
-
-def orientation_matrix(code: str, path: Path | str = "") -> np.ndarray:
-    """Matrix taking logged (gx, gy, gz) to sensor (x, y, z) for a Gyroflow code."""
-    if len(code) != 3 or sorted(code.upper()) != ["X", "Y", "Z"]:
-        raise GyroError(f"{path}: orientation must be a permutation of XYZ, got {code!r}")
-    M = np.zeros((3, 3))
-    for col, letter in enumerate(code):
-        M["XYZ".index(letter.upper()), col] = 1.0 if letter.isupper() else -1.0
-    return M
 
 
 def read_named_csv(
@@ -251,17 +257,22 @@ def detect_format(path: str | Path) -> str:
     raise GyroError(f"{path}:1: unknown gyro log layout ({len(fields)} fields)")
 
 
+# The registry: a format's name → its reader. Adding a format is a reader here, one line
+# below, and a test.
+READERS = {
+    "opencamera": read_opencamera,
+    "phone-cc9": read_phone_cc9,
+    "gcsv": read_gcsv,
+    "sensorlogger": read_named_csv,
+    "csv": read_named_csv,
+    "telemetry": read_telemetry,
+}
+FORMATS = tuple(READERS)
+
+
 def read_gyro(path: str | Path, fmt: str | None = None, **options) -> GyroLog:
     """Read a gyro log, detecting its format unless ``fmt`` is given."""
     fmt = fmt or detect_format(path)
-    readers = {
-        "opencamera": read_opencamera,
-        "phone-cc9": read_phone_cc9,
-        "gcsv": read_gcsv,
-        "sensorlogger": read_named_csv,
-        "csv": read_named_csv,
-        "telemetry": read_telemetry,
-    }
-    if fmt not in readers:
+    if fmt not in READERS:
         raise GyroError(f"unknown gyro format {fmt!r}; choose from {', '.join(FORMATS)}")
-    return readers[fmt](path, **options)
+    return READERS[fmt](path, **options)

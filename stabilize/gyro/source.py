@@ -4,13 +4,12 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from numpy.typing import NDArray
 from scipy.signal import butter, filtfilt
 
 from stabilize.gyro.integrate import Attitude, attitude
 from stabilize.gyro.log import GyroError, GyroLog
-from stabilize.gyro.sync import MIN_CORRELATION, Sync, synchronise
-from stabilize.track import VisualTrack
+from stabilize.gyro.sync import MIN_CORRELATION, Sync, SyncOptions
+from stabilize.motion.track import VisualTrack
 
 
 def lowpass(log: GyroLog, cutoff_hz: float) -> GyroLog:
@@ -23,14 +22,7 @@ def lowpass(log: GyroLog, cutoff_hz: float) -> GyroLog:
 
 
 def gyro_rotations(
-    log: GyroLog,
-    track: VisualTrack,
-    *,
-    offset: float | None = None,
-    R_cam_imu: NDArray | None = None,
-    readout: float | None = 0.0,
-    fit_drift: bool = False,
-    search: float = 1.0,
+    log: GyroLog, track: VisualTrack, options: SyncOptions | None = None
 ) -> tuple[Attitude, Sync]:
     """The camera attitude from the gyro, synchronised against the visual estimate, bias
     removed, in camera axes on the gyro clock (video time + ``sync.offset``).
@@ -38,15 +30,7 @@ def gyro_rotations(
     Refuses a log whose motion does not match the video's: stabilising from it would
     shake the clip instead.
     """
-    sync = synchronise(
-        log,
-        track,
-        search=(-search, search),
-        offset=offset,
-        R_cam_imu=R_cam_imu,
-        readout=readout,
-        fit_drift=fit_drift,
-    )
+    sync = (options or SyncOptions()).synchronise(log, track)
     if sync.correlation < MIN_CORRELATION:
         raise GyroError(
             f"{log.source}: the gyro's motion does not match the video's (speed correlation "

@@ -16,7 +16,6 @@ interpolated), which is what the visual estimate measures.
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass
 from functools import partial
 
@@ -24,8 +23,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rotation import so3
+from stabilize.gyro.axes import signed_permutations
 from stabilize.gyro.log import GyroError, GyroLog
-from stabilize.track import VisualTrack
+from stabilize.motion.track import VisualTrack
 
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 MIN_CORRELATION = 0.6  # of angular speeds, below which a log does not match the video
@@ -33,6 +33,31 @@ MIN_COVERAGE = 0.8  # share of the frame pairs the log must cover (camera logs s
 MAX_DRIFT = 2e-3  # clock-rate difference searched with fit_drift (crystals: ~1e-5..1e-4)
 MAX_READOUT_STDERR = 0.15  # of a frame interval: a less certain readout is not used
 MIN_BAND_SUPPORT = 0.05  # a band with so few agreeing vectors says little about its time
+
+
+@dataclass(frozen=True)
+class SyncOptions:
+    """What is given, and what is searched, when a log is synchronised to a video: an
+    ``offset`` (s), the axes ``R_cam_imu`` or a ``readout`` (s) given are kept (None:
+    estimated); ``search`` is the offset range, ± s; ``fit_drift`` also fits a clock drift."""
+
+    offset: float | None = None
+    R_cam_imu: NDArray | None = None
+    readout: float | None = 0.0
+    fit_drift: bool = False
+    search: float = 1.0
+
+    def synchronise(self, log: GyroLog, track: VisualTrack) -> Sync:
+        """:func:`synchronise` with these options."""
+        return synchronise(
+            log,
+            track,
+            search=(-self.search, self.search),
+            offset=self.offset,
+            R_cam_imu=self.R_cam_imu,
+            readout=self.readout,
+            fit_drift=self.fit_drift,
+        )
 
 
 @dataclass(frozen=True)
@@ -59,18 +84,6 @@ def drifted(times: NDArray, drift: float, origin: float) -> NDArray[np.float64]:
     """t + drift·(t - origin): a gyro clock running at 1 + drift times the video's rate."""
     times = np.asarray(times, dtype=np.float64)
     return times + drift * (times - origin)
-
-
-def signed_permutations() -> list[NDArray[np.float64]]:
-    """The 24 rotations that map axes onto signed axes."""
-    out = []
-    for perm in itertools.permutations(range(3)):
-        for signs in itertools.product((1.0, -1.0), repeat=3):
-            M = np.zeros((3, 3))
-            M[range(3), perm] = signs
-            if np.linalg.det(M) > 0:
-                out.append(M)
-    return out
 
 
 def visual_rates(times: NDArray, R: NDArray) -> NDArray[np.float64]:
@@ -257,7 +270,7 @@ def estimate_readout(
     return float(np.average(y - readout * x, weights=w)), readout
 
 
-def refine(
+def refine_offset_and_axes(
     gyro: IntervalRates,
     times: NDArray,
     w_vis: NDArray,
@@ -314,7 +327,7 @@ def synchronise(
         corr = speed_correlation(gyro, times, w_vis, delta)
     R, bias = fit_axes(w_vis, gyro(times, delta), R_cam_imu)
     fit = offset is None
-    delta, R, bias = refine(gyro, times, w_vis, delta, 0.0, fit, R_cam_imu, R, bias)
+    delta, R, bias = refine_offset_and_axes(gyro, times, w_vis, delta, 0.0, fit, R_cam_imu, R, bias)
     estimated = readout is None and track.bands is not None and offset is None
     if estimated:
         delta, readout = estimate_readout(gyro, track, R, bias, delta)
@@ -324,20 +337,22 @@ def synchronise(
         lag = readout * track.rows
         if not estimated and offset is None:
             delta -= readout * float(np.mean(track.rows))  # the content offset → first row
-        delta, R, bias = refine(gyro, times, w_vis, delta, lag, fit, R_cam_imu, R, bias)
+        delta, R, bias = refine_offset_and_axes(
+            gyro, times, w_vis, delta, lag, fit, R_cam_imu, R, bias
+        )
         corr = speed_correlation(gyro, times, w_vis, delta, lag)
     drift = 0.0
     if fit_drift:
         lag = readout * track.rows
 
         def cost(eps: float) -> float:
-            d = refine(
+            d = refine_offset_and_axes(
                 gyro, drifted(times, eps, times[0]), w_vis, delta, lag, fit, R_cam_imu, R, bias
             )[0]
             return rate_error(gyro, drifted(times, eps, times[0]), w_vis, R, bias, d, lag)
 
         drift = golden_section(cost, -max_drift, max_drift, tol=1e-7)
-        delta, R, bias = refine(
+        delta, R, bias = refine_offset_and_axes(
             gyro, drifted(times, drift, times[0]), w_vis, delta, lag, fit, R_cam_imu, R, bias
         )
     return Sync(delta, R, bias, corr, readout, estimated, drift, float(times[0]))

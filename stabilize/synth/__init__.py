@@ -30,14 +30,16 @@ from scipy.spatial.transform import Rotation
 
 from rotation import so3
 from rotation.camera import focal_from_fov, intrinsics
-from stabilize.ffmpeg_tools import atomic_output
+from rotation.synthetic import Street
 from stabilize.synth import trajectory
-from stabilize.synth.scene import Scene, Street, cast, ground_truth_flow, random_crowd
+from stabilize.synth.scene import Scene, cast, ground_truth_flow, random_crowd
 from stabilize.synth.textures import load_background
 from stabilize.synth.trajectory import Handheld
-from stabilize.video_writer import Encoding, FrameWriter, sine_audio
+from stabilize.video import atomic_output
+from stabilize.video.encode import Encoding, FrameWriter, sine_audio
 
 # A phone's gyro axes against its camera's: x_cam = y_imu, y_cam = x_imu, z_cam = -z_imu.
+SCENE_LENGTH_M = 150.0  # the street is drawn this far; beyond it, the background
 DEFAULT_R_CAM_IMU = ((0.0, 1.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, -1.0))
 
 
@@ -89,13 +91,13 @@ class SynthOptions:
         return intrinsics(self.focal, self.size)
 
 
-def frame_times(opts: SynthOptions) -> NDArray[np.float64]:
+def clip_times(opts: SynthOptions) -> NDArray[np.float64]:
     return np.arange(opts.n_frames) / opts.fps
 
 
 def build_scene(opts: SynthOptions) -> Scene:
     rng = np.random.default_rng(opts.seed + 1)
-    street = Street(walls=opts.walls)
+    street = Street(length=SCENE_LENGTH_M, walls=opts.walls)
     reach = 30.0 + opts.walk * opts.seconds
     crowd = random_crowd(rng, opts.crowd, street, reach)
     bg = load_background(Path(opts.background) if opts.background else None, rng)
@@ -180,7 +182,7 @@ def gyro_samples(opts: SynthOptions) -> tuple[NDArray, NDArray]:
 
 
 def write_truth(out: Path, opts: SynthOptions) -> None:
-    t = frame_times(opts)
+    t = clip_times(opts)
     O = trajectory.orientation(opts.motion, t)
     R = O[1:] @ np.swapaxes(O[:-1], -1, -2)
     rotvecs = so3.log_so3(R)
@@ -230,7 +232,7 @@ def render_clip(
                 writer.write(frame)
                 if progress:
                     progress(1)
-    R = trajectory.relative_rotations(opts.motion, frame_times(opts))
+    R = trajectory.relative_rotations(opts.motion, clip_times(opts))
     return {
         "out_dir": str(out),
         "frames": opts.n_frames,

@@ -1,10 +1,11 @@
 """A piecewise-planar street, ray-cast per pixel, with exact ground-truth flow.
 
 World axes are the first frame's camera axes (x right, y down, z forward, metres).
-The ground is the plane y = ``ground_y``; optional building fronts are the planes
-x = ±``half_width`` up to ``wall_height``; people are upright billboards facing the
-street's axis (planes z = const) that walk with their own velocities; everything else
-is far background, seen by direction only.
+The ground is the plane y = ``camera_height`` (:class:`rotation.synthetic.Street`, the
+street of the estimator's synthetic flows, drawn 150 m long here); optional building
+fronts are the planes x = ±``half_width`` up to ``wall_height``; people are upright
+billboards facing the street's axis (planes z = const) that walk with their own
+velocities; everything else is far background, seen by direction only.
 
 Each pixel's ray is intersected with every surface and the nearest hit is kept, so
 occlusion is exact. Texture lookups use a small mip chain chosen per pixel from its
@@ -19,6 +20,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from rotation.synthetic import Street
 from stabilize.synth.textures import (
     PX_PER_M,
     Background,
@@ -29,15 +31,6 @@ from stabilize.synth.textures import (
 )
 
 N_SPRITES = 8
-
-
-@dataclass(frozen=True)
-class Street:
-    ground_y: float = 1.5
-    half_width: float = 6.0
-    wall_height: float = 12.0
-    length: float = 150.0
-    walls: bool = True
 
 
 @dataclass(frozen=True)
@@ -151,7 +144,7 @@ def _person_box(scene: Scene, i: int, C, c, t, rays) -> tuple[slice, slice] | No
         zp = cr.z[i] + cr.vz[i] * t[row]
         xp = cr.x[i] + cr.vx[i] * t[row]
         for dx in (-0.5, 0.5):
-            for y in (st.ground_y, st.ground_y - cr.height[i]):
+            for y in (st.camera_height, st.camera_height - cr.height[i]):
                 X = C[row].T @ (np.array([xp + dx * cr.width[i], y, zp]) - c[row])
                 if X[2] < 0.05:
                     return (slice(0, h), slice(0, w)) if X[2] > -1.0 else None
@@ -167,6 +160,34 @@ def _person_box(scene: Scene, i: int, C, c, t, rays) -> tuple[slice, slice] | No
     return slice(y0, y1), slice(x0, x1)
 
 
+@dataclass(frozen=True)
+class _Canvas:
+    """One frame being painted: world ray directions d (H, W, 3) from origins o (H, 1, 3),
+    and the nearest hit so far per pixel (depth along d, colour, velocity)."""
+
+    d: NDArray
+    o: NDArray
+    depth: NDArray
+    colour: NDArray
+    velocity: NDArray
+    focal: float
+
+    @property
+    def flat_d(self) -> NDArray:
+        return self.d.reshape(-1, 3)
+
+    def origins(self, idx: NDArray) -> NDArray:
+        """The ray origin of each flat pixel index."""
+        return self.o.reshape(-1, 3)[idx // self.d.shape[1]]
+
+    def footprint(self, idx: NDArray, s: NDArray, axis: int) -> NDArray:
+        """Texels per pixel on a plane whose normal is world axis ``axis``."""
+        dd = self.flat_d[idx]
+        n = np.linalg.norm(dd, axis=1)
+        grazing = np.maximum(np.abs(dd[:, axis]) / n, 0.02)
+        return PX_PER_M * s * n / self.focal / np.sqrt(grazing)
+
+
 def cast(scene: Scene, rays: NDArray, C: NDArray, c: NDArray, t: NDArray, focal: float) -> Hits:
     """Render one frame.
 
@@ -177,93 +198,99 @@ def cast(scene: Scene, rays: NDArray, C: NDArray, c: NDArray, t: NDArray, focal:
         t: time per row, (H,), for the walking people.
         focal: focal length in pixels (texture footprint).
     """
-    st = scene.street
     if np.all(C == C[:1]):  # global shutter: one rotation for every row
         d = rays @ C[0].T.astype(rays.dtype)
     else:
         d = np.einsum("hij,hwj->hwi", C, rays)  # world directions, (H, W, 3)
-    o = c[:, None, :]
     h, w = d.shape[:2]
-    depth = np.full((h, w), np.inf)
-    colour = np.zeros((h, w, 3), np.uint8)
-    velocity = np.zeros((h, w, 3), np.float32)
-    flat_colour = colour.reshape(-1, 3)
-    flat_d = d.reshape(-1, 3)
-
-    def footprint(idx: NDArray, s: NDArray, axis: int) -> NDArray:
-        """Texels per pixel on a plane whose normal is world axis ``axis``."""
-        dd = flat_d[idx]
-        n = np.linalg.norm(dd, axis=1)
-        grazing = np.maximum(np.abs(dd[:, axis]) / n, 0.02)
-        return PX_PER_M * s * n / focal / np.sqrt(grazing)
-
+    canvas = _Canvas(
+        d,
+        c[:, None, :],
+        np.full((h, w), np.inf),
+        np.zeros((h, w, 3), np.uint8),
+        np.zeros((h, w, 3), np.float32),
+        focal,
+    )
     with np.errstate(divide="ignore", invalid="ignore"):
-        # Ground: y = ground_y.
-        s = np.where(d[..., 1] > 1e-9, (st.ground_y - o[..., 1]) / d[..., 1], np.inf)
-        s[s * d[..., 2] + o[..., 2] > st.length] = np.inf
-        if st.walls:
-            s[np.abs(o[..., 0] + s * d[..., 0]) > st.half_width] = np.inf
-        idx = np.flatnonzero(np.isfinite(s))
-        if idx.size:
-            sf = s.ravel()[idx]
-            x = o.reshape(-1, 3)[idx // w, 0] + sf * flat_d[idx, 0]
-            z = o.reshape(-1, 3)[idx // w, 2] + sf * flat_d[idx, 2]
-            _paint(
-                flat_colour, idx, scene.ground, x * PX_PER_M, z * PX_PER_M, footprint(idx, sf, 1)
-            )
-            depth.ravel()[idx] = sf
-
-        # Walls: x = ±half_width, from the ground up to wall_height.
-        for side in (-1.0, 1.0) if st.walls else ():
-            s = np.where(
-                side * d[..., 0] > 1e-9, (side * st.half_width - o[..., 0]) / d[..., 0], np.inf
-            )
-            idx = np.flatnonzero(s < depth)
-            if not idx.size:
-                continue
-            sf = s.ravel()[idx]
-            oo = o.reshape(-1, 3)[idx // w]
-            y = oo[:, 1] + sf * flat_d[idx, 1]
-            z = oo[:, 2] + sf * flat_d[idx, 2]
-            keep = (y <= st.ground_y) & (y >= st.ground_y - st.wall_height) & (z <= st.length)
-            idx, sf, y, z = idx[keep], sf[keep], y[keep], z[keep]
-            u, v = (z * side + 1000.0) * PX_PER_M, (y - st.ground_y) * PX_PER_M + 4096
-            _paint(flat_colour, idx, scene.facade, u, v, footprint(idx, sf, 0))
-            depth.ravel()[idx] = sf
-
-        # People: planes z = zp(t), nearest last so that they overwrite farther ones.
-        cr = scene.crowd
-        for i in np.argsort(-cr.z):
-            box = _person_box(scene, i, C, c, t, rays)
-            if box is None:
-                continue
-            r, k = box
-            zp = cr.z[i] + cr.vz[i] * t[r]
-            xp = cr.x[i] + cr.vx[i] * t[r]
-            dd, oo = d[r, k], o[r]
-            s = (zp[:, None] - oo[..., 2]) / dd[..., 2]
-            x = oo[..., 0] + s * dd[..., 0] - xp[:, None]
-            y = oo[..., 1] + s * dd[..., 1]
-            inside = (s > 0.05) & (np.abs(x) < cr.width[i] / 2)
-            inside &= (y < st.ground_y) & (y > st.ground_y - cr.height[i]) & (s < depth[r, k])
-            if not inside.any():
-                continue
-            sprite = scene.sprites[cr.sprite[i]]
-            sh, sw = sprite.shape[:2]
-            u = ((x / cr.width[i] + 0.5) * sw).astype(np.float32)
-            v = ((y - st.ground_y + cr.height[i]) / cr.height[i] * sh).astype(np.float32)
-            got = cv2.remap(sprite, u, v, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
-            sel = inside & (got[..., 3] > 127)
-            np.copyto(colour[r, k], got[..., :3], where=sel[..., None])
-            np.copyto(depth[r, k], s, where=sel)
-            np.copyto(velocity[r, k], np.float32([cr.vx[i], 0.0, cr.vz[i]]), where=sel[..., None])
-
+        _cast_ground(scene, canvas)
+        for side in (-1.0, 1.0) if scene.street.walls else ():
+            _cast_wall(scene, canvas, side)
+        _cast_people(scene, canvas, rays, C, c, t)
     # The far background, only where nothing nearer was hit.
-    idx = np.flatnonzero(np.isinf(depth))
+    idx = np.flatnonzero(np.isinf(canvas.depth))
     if idx.size:
-        mx, my = scene.background.coords(d.reshape(-1, 3)[idx])
-        colour.reshape(-1, 3)[idx] = _lookup(scene.background.texture, mx, my, cv2.BORDER_WRAP)
-    return Hits(colour, depth, d, o, velocity)
+        mx, my = scene.background.coords(canvas.flat_d[idx])
+        flat_colour = canvas.colour.reshape(-1, 3)
+        flat_colour[idx] = _lookup(scene.background.texture, mx, my, cv2.BORDER_WRAP)
+    return Hits(canvas.colour, canvas.depth, d, canvas.o, canvas.velocity)
+
+
+def _cast_ground(scene: Scene, cv: _Canvas) -> None:
+    """The ground, y = camera_height, up to the street's length and between its walls."""
+    st, d, o = scene.street, cv.d, cv.o
+    s = np.where(d[..., 1] > 1e-9, (st.camera_height - o[..., 1]) / d[..., 1], np.inf)
+    s[s * d[..., 2] + o[..., 2] > st.length] = np.inf
+    if st.walls:
+        s[np.abs(o[..., 0] + s * d[..., 0]) > st.half_width] = np.inf
+    idx = np.flatnonzero(np.isfinite(s))
+    if idx.size:
+        sf = s.ravel()[idx]
+        oo = cv.origins(idx)
+        x = oo[:, 0] + sf * cv.flat_d[idx, 0]
+        z = oo[:, 2] + sf * cv.flat_d[idx, 2]
+        flat_colour = cv.colour.reshape(-1, 3)
+        _paint(flat_colour, idx, scene.ground, x * PX_PER_M, z * PX_PER_M, cv.footprint(idx, sf, 1))
+        cv.depth.ravel()[idx] = sf
+
+
+def _cast_wall(scene: Scene, cv: _Canvas, side: float) -> None:
+    """A building front, x = side · half_width, from the ground up to wall_height."""
+    st, d, o = scene.street, cv.d, cv.o
+    s = np.where(side * d[..., 0] > 1e-9, (side * st.half_width - o[..., 0]) / d[..., 0], np.inf)
+    idx = np.flatnonzero(s < cv.depth)
+    if not idx.size:
+        return
+    sf = s.ravel()[idx]
+    oo = cv.origins(idx)
+    y = oo[:, 1] + sf * cv.flat_d[idx, 1]
+    z = oo[:, 2] + sf * cv.flat_d[idx, 2]
+    keep = (y <= st.camera_height) & (y >= st.camera_height - st.wall_height) & (z <= st.length)
+    idx, sf, y, z = idx[keep], sf[keep], y[keep], z[keep]
+    u, v = (z * side + 1000.0) * PX_PER_M, (y - st.camera_height) * PX_PER_M + 4096
+    _paint(cv.colour.reshape(-1, 3), idx, scene.facade, u, v, cv.footprint(idx, sf, 0))
+    cv.depth.ravel()[idx] = sf
+
+
+def _cast_people(
+    scene: Scene, cv: _Canvas, rays: NDArray, C: NDArray, c: NDArray, t: NDArray
+) -> None:
+    """People: planes z = zp(t), nearest last so that they overwrite farther ones."""
+    st, cr = scene.street, scene.crowd
+    for i in np.argsort(-cr.z):
+        box = _person_box(scene, i, C, c, t, rays)
+        if box is None:
+            continue
+        r, k = box
+        zp = cr.z[i] + cr.vz[i] * t[r]
+        xp = cr.x[i] + cr.vx[i] * t[r]
+        dd, oo = cv.d[r, k], cv.o[r]
+        s = (zp[:, None] - oo[..., 2]) / dd[..., 2]
+        x = oo[..., 0] + s * dd[..., 0] - xp[:, None]
+        y = oo[..., 1] + s * dd[..., 1]
+        inside = (s > 0.05) & (np.abs(x) < cr.width[i] / 2)
+        feet = st.camera_height
+        inside &= (y < feet) & (y > feet - cr.height[i]) & (s < cv.depth[r, k])
+        if not inside.any():
+            continue
+        sprite = scene.sprites[cr.sprite[i]]
+        sh, sw = sprite.shape[:2]
+        u = ((x / cr.width[i] + 0.5) * sw).astype(np.float32)
+        v = ((y - feet + cr.height[i]) / cr.height[i] * sh).astype(np.float32)
+        got = cv2.remap(sprite, u, v, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
+        sel = inside & (got[..., 3] > 127)
+        np.copyto(cv.colour[r, k], got[..., :3], where=sel[..., None])
+        np.copyto(cv.depth[r, k], s, where=sel)
+        np.copyto(cv.velocity[r, k], np.float32([cr.vx[i], 0.0, cr.vz[i]]), where=sel[..., None])
 
 
 def ground_truth_flow(

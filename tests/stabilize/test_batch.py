@@ -14,8 +14,9 @@ from typer.testing import CliRunner
 
 from stabilize.batch import find_jobs
 from stabilize.cli import app
+from tests.stabilize.helpers import SAMPLE as SAMPLE_DIR
 
-SAMPLE = Path(__file__).resolve().parents[2] / "samples" / "street" / "clip.mp4"
+SAMPLE = SAMPLE_DIR / "clip.mp4"
 
 
 def digest(path: Path) -> str:
@@ -110,41 +111,13 @@ def test_a_killed_run_leaves_nothing_unfinished_under_a_final_name(folder, tmp_p
     assert len(list(out.rglob("*.mp4"))) == 2
 
 
-def test_batch_errors():
-    result = CliRunner().invoke(app, ["batch", "no-such-folder", "out"])
-    assert result.exit_code != 0 and "not a folder" in result.output
-
-
 @pytest.mark.parametrize("workers", [1, 2])
 def test_frames_written_are_reported_from_every_worker(folder, tmp_path, workers):
+    from stabilize import Settings
     from stabilize.batch import run_batch
-    from stabilize.pipeline import Settings
 
     jobs = [j for j in find_jobs(folder, tmp_path / "out", "*", True) if "corrupt" not in j.input]
     jobs = [j for j in jobs if j.input.endswith(".mp4")]
     frames, files = [], []
     run_batch(jobs, tmp_path / "out", Settings(), workers, files.append, on_frames=frames.append)
     assert len(files) == 2 and sum(frames) == 2 * 90
-
-
-def test_batch_takes_every_option_of_the_single_file_command():
-    import typer
-
-    commands = typer.main.get_command(app).commands
-    names = {name: {p.name for p in commands[name].params} for name in ("run", "batch")}
-    per_file = {"input_path", "output_path", "report", "overwrite", "as_json"}
-    per_clip_gyro = {"gyro_offset", "gyro_axes"}  # each clip's log has its own
-    assert names["run"] - per_file - per_clip_gyro <= names["batch"]
-
-
-def test_batch_passes_the_options_on(tmp_path):
-    from stabilize.video_reader import probe
-
-    src = tmp_path / "in"
-    src.mkdir()
-    (src / "a.mp4").write_bytes(SAMPLE.read_bytes())
-    out = tmp_path / "out"
-    args = ["batch", str(src), str(out), "--size", "320x180", "--crop", "none", "-q"]
-    result = CliRunner().invoke(app, args)
-    assert result.exit_code == 0, result.output
-    assert probe(out / "a.mp4").size == (180, 320)

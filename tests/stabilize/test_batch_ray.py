@@ -1,15 +1,15 @@
 """The same batch as Ray tasks on a real local Ray instance (2 CPUs)."""
 
 import json
-from pathlib import Path
 
 import pytest
 
+from stabilize import Settings
 from stabilize.batch import find_jobs, run_batch
-from stabilize.pipeline import Settings
+from tests.stabilize.helpers import SAMPLE as SAMPLE_DIR
 
 ray = pytest.importorskip("ray", reason="the 'cluster' extra (ray) is not installed")
-SAMPLE = Path(__file__).resolve().parents[2] / "samples" / "street" / "clip.mp4"
+SAMPLE = SAMPLE_DIR / "clip.mp4"
 
 
 @pytest.fixture(scope="module")

@@ -1,5 +1,4 @@
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -7,9 +6,8 @@ import pytest
 from rotation import so3
 from stabilize.gyro import GyroError, GyroLog, integrate_rotations, read_opencamera
 from stabilize.gyro.integrate import attitude
-from stabilize.rotation_files import read_rotations
-
-SAMPLE = Path(__file__).resolve().parents[3] / "samples" / "street"
+from stabilize.motion.files import read_rotations
+from tests.stabilize.helpers import SAMPLE
 
 
 def test_gyro_log_integrated_with_the_truth_offset_and_axes_reproduces_truth():

@@ -1,5 +1,4 @@
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,8 +10,7 @@ from stabilize.gyro import GyroError, GyroLog, read_gyro
 from stabilize.gyro.export import write_gcsv
 from stabilize.gyro.source import lowpass
 from stabilize.gyro.sync import visual_rates
-
-SAMPLE = Path(__file__).resolve().parents[3] / "samples" / "street"
+from tests.stabilize.helpers import SAMPLE
 
 
 def test_gcsv_export_round_trips_through_the_reader(tmp_path):

@@ -8,12 +8,12 @@ from typer.testing import CliRunner
 from rotation import so3
 from stabilize.cli import app
 from stabilize.gyro import GyroLog, read_gyro
-from stabilize.gyro.sync import signed_permutations, synchronise, visual_rates
-from stabilize.rotation_files import read_rotations
+from stabilize.gyro.axes import signed_permutations
+from stabilize.gyro.sync import synchronise, visual_rates
+from stabilize.motion.files import read_rotations
+from stabilize.motion.track import VisualTrack
 from stabilize.synth import SynthOptions, render_clip
-from stabilize.track import VisualTrack
-
-SAMPLE = Path(__file__).resolve().parents[3] / "samples" / "street"
+from tests.stabilize.helpers import SAMPLE
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,132 @@
+"""``stabilize batch IN_DIR OUT_DIR``: a folder of clips, resumable, locally or on Ray."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from stabilize.cli.app import app, fail
+from stabilize.cli.options import (
+    ENCODING,
+    NO_PREVIEW,
+    CodecOption,
+    CrfOption,
+    CropOption,
+    DeviceOption,
+    FlowOption,
+    FocalOption,
+    FovOption,
+    GyroDriftOption,
+    GyroFormatOption,
+    GyroLpfOption,
+    LensOption,
+    LockOption,
+    MaxZoomOption,
+    MethodOption,
+    PresetOption,
+    PreviewOption,
+    QuietOption,
+    RaftWeightsOption,
+    ReadoutOption,
+    SizeOption,
+    SmoothOption,
+    job_settings,
+)
+from stabilize.settings import DEFAULTS
+
+
+@app.command(
+    epilog=(
+        "Examples:\n\n"
+        "  stabilize batch trip/ trip-steady/\n\n"
+        "  stabilize batch phone/ out/ --recursive --pattern '*.mp4' --workers 2\n\n"
+        "  stabilize batch clips/ out/ --gyro auto   # clip.gcsv or clip.csv beside clip.mp4\n\n"
+        "  stabilize batch /shared/in /shared/out --ray auto"
+    )
+)
+def batch(
+    ctx: typer.Context,
+    in_dir: Path = typer.Argument(..., help="Folder of clips."),
+    out_dir: Path = typer.Argument(..., help="Where the stabilised clips go (same tree)."),
+    workers: int | None = typer.Option(None, min=1, help="Parallel files (default: per core)."),
+    pattern: str = typer.Option("*", help="Which files, as a glob."),
+    recursive: bool = typer.Option(False, help="Descend into subfolders."),
+    gyro: str | None = typer.Option(None, help="'auto': use a gyro log with the same base name."),
+    ray: str | None = typer.Option(
+        None, help="Run on a Ray cluster: its address, or 'auto' (needs the 'cluster' extra)."
+    ),
+    flow_name: FlowOption = DEFAULTS.flow,
+    raft_weights: RaftWeightsOption = None,
+    device: DeviceOption = DEFAULTS.device,
+    fov: FovOption = DEFAULTS.fov,
+    focal: FocalOption = DEFAULTS.focal,
+    lens: LensOption = None,
+    smooth: SmoothOption = DEFAULTS.smooth,
+    method: MethodOption = DEFAULTS.method,
+    lock: LockOption = False,
+    max_zoom: MaxZoomOption = DEFAULTS.max_zoom,
+    crop: CropOption = DEFAULTS.crop,
+    codec: CodecOption = ENCODING.codec,
+    crf: CrfOption = ENCODING.crf,
+    preset: PresetOption = ENCODING.preset,
+    preview: PreviewOption = NO_PREVIEW,
+    size: SizeOption = None,
+    gyro_format: GyroFormatOption = None,
+    gyro_lpf: GyroLpfOption = DEFAULTS.gyro_lpf,
+    gyro_drift: GyroDriftOption = DEFAULTS.gyro_drift,
+    readout_ms: ReadoutOption = None,
+    quiet: QuietOption = False,
+) -> None:
+    """Stabilise every clip in a folder: resumable, one failure never stops the rest."""
+    from rich.console import Console
+
+    from stabilize.batch import find_jobs, run_batch
+    from stabilize.cli.bars import batch_progress
+
+    if not in_dir.is_dir():
+        fail(f"{in_dir}: not a folder")
+    if gyro not in (None, "auto"):
+        fail("--gyro in batch mode takes 'auto' (a sidecar log per clip)")
+    settings = job_settings(ctx.params)
+    jobs = find_jobs(in_dir, out_dir, pattern, recursive, gyro_auto=gyro == "auto")
+    if not jobs:
+        fail(f"{in_dir}: no files match {pattern!r}")
+    console = Console(stderr=True)
+    with batch_progress(len(jobs), quiet=quiet) as (file_done, frames_done):
+
+        def done(row: dict) -> None:
+            file_done()
+            if not quiet:
+                console.print(f"{row['status']:8s} {row['input']}  {row.get('error', '')}")
+
+        try:
+            rows = run_batch(
+                jobs, out_dir, settings, workers, done, ray_address=ray, on_frames=frames_done
+            )
+        except (RuntimeError, ConnectionError) as err:
+            fail(str(err).splitlines()[0])
+    _print_rows(rows, out_dir, quiet)
+
+
+def _print_rows(rows: list[dict], out_dir: Path, quiet: bool) -> None:
+    """The batch's table of files, and exit status 1 if any failed."""
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title=f"{len(rows)} files → {out_dir}")
+    for column in ("input", "status", "seconds", "zoom", "error"):
+        table.add_column(column)
+    for row in rows:
+        zoom = f"{row['zoom']:.3f}" if row.get("zoom") else ""
+        table.add_row(
+            row["input"], row["status"], f"{row.get('seconds', 0):.1f}", zoom, row.get("error", "")
+        )
+    if not quiet:
+        Console(stderr=True).print(table)
+    failed = sum(row["status"] == "failed" for row in rows)
+    if failed:
+        typer.echo(
+            f"{failed} of {len(rows)} files failed (see {out_dir / 'manifest.json'})", err=True
+        )
+        raise typer.Exit(1)

@@ -1,0 +1,172 @@
+"""``stabilize compare VIDEO --gyro LOG``: the visual estimate against a gyroscope."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import typer
+from numpy.typing import NDArray
+
+from stabilize.cli.app import app, fail
+from stabilize.cli.bars import progress_bar
+from stabilize.cli.options import (
+    FlowOption,
+    FocalOption,
+    FovOption,
+    GyroFormatOption,
+    JsonOption,
+    LensOption,
+    QuietOption,
+    RaftWeightsOption,
+    axes_matrix,
+    flow_settings,
+    readout,
+)
+from stabilize.progress import ProgressFactory
+from stabilize.settings import DEFAULTS
+from stabilize.video.probe import VideoInfo
+
+
+@app.command(
+    epilog=(
+        "Examples:\n\n"
+        "  stabilize compare clip.mp4 --gyro gyro.csv --report cmp/\n\n"
+        "  stabilize compare 'frames/RE_frame-%d.jpg' --start-number 99 --gyro gyro.txt "
+        "--timestamps framestamp.txt --focal 573.85 --json\n\n"
+        "  stabilize compare clip.mp4 --gyro log.gcsv --offset 0.042 --axes YXz\n\n"
+        "  stabilize compare clip.mp4 --gyro gyro.csv --calibrate-focal --drift"
+    )
+)
+def compare(
+    ctx: typer.Context,
+    video: str = typer.Argument(..., help="A video, or an image pattern like dir/img-%d.jpg."),
+    gyro: Path = typer.Option(..., help="The gyro log."),
+    gyro_format: GyroFormatOption = None,
+    timestamps: Path | None = typer.Option(
+        None, help="Frame times on the gyro clock (OpenCamera ns, or seconds per line)."
+    ),
+    start_number: int | None = typer.Option(None, help="First image number of a pattern."),
+    fps: float | None = typer.Option(None, help="Frame rate of an image sequence."),
+    fov: FovOption = DEFAULTS.fov,
+    focal: FocalOption = DEFAULTS.focal,
+    lens: LensOption = None,
+    offset: float | None = typer.Option(None, help="Gyro minus video clock, s (skip the search)."),
+    axes: str | None = typer.Option(None, help="IMU axis of camera x, y, z, e.g. YXz."),
+    search: float = typer.Option(1.0, min=0.0, help="Offset search range, ± seconds."),
+    readout_ms: str = typer.Option(
+        "auto",
+        help="Rolling-shutter readout, ms (0: global shutter), or 'auto': the log's value, "
+        "else estimated from bands of the frame.",
+    ),
+    drift: bool = typer.Option(False, "--drift", help="Also fit a linear clock drift."),
+    calibrate_focal: bool = typer.Option(
+        False,
+        "--calibrate-focal",
+        help="Fit the focal length to the gyro (estimates the rotations again with it).",
+    ),
+    flow_name: FlowOption = DEFAULTS.flow,
+    raft_weights: RaftWeightsOption = None,
+    report: Path | None = typer.Option(None, help="Write pairs.csv, summary.json and plots here."),
+    as_json: JsonOption = False,
+    quiet: QuietOption = False,
+) -> None:
+    """Compare the visual rotation estimate with a gyroscope log."""
+    with contextlib.ExitStack() as stack:
+
+        def bar(label: str, total: int | None):
+            return stack.enter_context(progress_bar(label, total, quiet=quiet))
+
+        result = _comparison(ctx.params, bar)
+    summary = result.summary() | {"focal_calibrated": calibrate_focal}
+    if report is not None:
+        from stabilize.evaluate.compare import write_comparison
+
+        write_comparison(report, result)
+    if summary["warning"]:
+        typer.secho(f"WARNING: {summary['warning']}", err=True, fg="red", bold=True)
+    if as_json:
+        typer.echo(json.dumps(summary, indent=2))
+        return
+    typer.echo(_describe(summary))
+
+
+def _comparison(params: dict, bar: ProgressFactory):
+    """The comparison the parsed options ``params`` ask for; any failure is one line."""
+    from stabilize.evaluate.compare import compare_video
+    from stabilize.gyro import GyroError, read_gyro
+    from stabilize.gyro.path import readout_seconds
+    from stabilize.gyro.sync import SyncOptions
+    from stabilize.video import VideoError
+    from stabilize.warp.lens import read_lens_profile
+
+    flow_name, weights, fov, focal = (
+        params[k] for k in ("flow_name", "raft_weights", "fov", "focal")
+    )
+    settings = flow_settings(flow_name, weights, "cpu", fov=fov, focal=focal, max_deg=15.0)
+    R_cam_imu = axes_matrix(params["axes"])
+    calibrate = params["calibrate_focal"]
+    try:
+        log = read_gyro(params["gyro"], params["gyro_format"])
+        info, times = _video_and_times(
+            params["video"], params["start_number"], params["fps"], params["timestamps"]
+        )
+        camera = read_lens_profile(params["lens"], info.size) if params["lens"] else None
+        if camera is not None and calibrate:
+            fail("--calibrate-focal fits a pinhole focal length; --lens brings its own")
+        if camera is not None:
+            settings = replace(settings, focal=float(camera.K[0, 0]))
+        # Unlike the stabiliser, compare estimates (None) a readout the log does not give.
+        parsed = readout(params["readout_ms"], params["gyro"])
+        given = log.readout_s or (camera and camera.readout_s)
+        known = given if parsed == "auto" else readout_seconds(parsed, None)
+        options = SyncOptions(params["offset"], R_cam_imu, known, params["drift"], params["search"])
+        return compare_video(
+            params["video"],
+            info,
+            log,
+            settings,
+            times,
+            options,
+            lens=camera,
+            calibrate_focal=calibrate,
+            progress=bar,
+        )
+    except (VideoError, GyroError, ValueError) as err:
+        fail(str(err))
+
+
+def _video_and_times(
+    video: str, start_number: int | None, fps: float | None, timestamps: Path | None
+) -> tuple[VideoInfo, NDArray]:
+    """The video (or image sequence) and its frame times: the container's, or those of a
+    ``timestamps`` file on the sensor's clock (line N is image N of a sequence)."""
+    from stabilize.video import frame_times, probe, sequence_args
+
+    args = sequence_args(video, start_number, fps)
+    info = probe(video, args)
+    times = frame_times(video, args)
+    if timestamps is not None:
+        from stabilize.gyro.readers import sensor_frame_times
+
+        first = (start_number or 1) - 1 if args else 0
+        times = sensor_frame_times(timestamps, first, len(times))
+    return info, times
+
+
+def _describe(summary: dict) -> str:
+    """The comparison in three lines of text."""
+    estimated = " (estimated)" if summary["readout_estimated"] else ""
+    return (
+        f"{summary['frames']} pairs: AAE {summary['aae_deg']:.4f}°, median "
+        f"{summary['median_deg']:.4f}°, p95 {summary['p95_deg']:.4f}° (pitch "
+        f"{summary['aae_pitch_deg']:.4f}°, yaw {summary['aae_yaw_deg']:.4f}°, roll "
+        f"{summary['aae_roll_deg']:.4f}°)\noffset {1000 * summary['offset_s']:+.2f} ms, readout "
+        f"{summary['readout_ms']:.1f} ms{estimated}, gyro "
+        f"{summary['gyro_rate_hz']:.1f} Hz, focal {summary['focal_px']:.1f} px, speed "
+        f"correlation {summary['speed_correlation']:.3f}\nR_cam_imu = "
+        f"{np.round(np.array(summary['R_cam_imu']), 4).tolist()}"
+    )

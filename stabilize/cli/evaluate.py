@@ -1,0 +1,76 @@
+"""``stabilize evaluate``: the quality metrics of a stabilised clip and its original."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from stabilize.cli.app import app, fail
+
+
+@app.command(
+    epilog=(
+        "Examples:\n\n"
+        "  stabilize evaluate shaky.mp4 steady.mp4\n\n"
+        "  stabilize evaluate shaky.mp4 vidstab.mp4 --json > metrics.json\n\n"
+        "  stabilize evaluate clip.mp4 out.mp4 --truth truth.csv --rotations rotations.csv"
+    )
+)
+def evaluate(
+    original: Path = typer.Argument(..., help="The input clip."),
+    stabilised: Path = typer.Argument(..., help="Its stabilised version (from any tool)."),
+    truth: Path | None = typer.Option(None, help="truth.csv of a rendered clip."),
+    rotations: Path | None = typer.Option(
+        None, help="An estimated rotations file (frame,t,rx,ry,rz,...) to score against --truth."
+    ),
+    as_json: bool = typer.Option(False, "--json", help="Print the results as JSON on stdout."),
+) -> None:
+    """Cropping ratio, distortion, stability and ITF of a stabilised clip and its original."""
+    from stabilize.evaluate.metrics import evaluate_pair
+    from stabilize.motion.files import angular_errors, read_rotations
+    from stabilize.video import VideoError, probe, read_frames
+
+    if (truth is None) != (rotations is None):
+        fail("--truth and --rotations go together")
+    try:
+        info_o, info_s = probe(original), probe(stabilised)
+        size = info_o.size
+        before, after = evaluate_pair(
+            read_frames(original, info=info_o), read_frames(stabilised, size, info_s)
+        )
+        result = {"original": before.as_dict(), "stabilised": after.as_dict()}
+        if truth is not None:
+            err = angular_errors(read_rotations(rotations), read_rotations(truth))
+            result["rotations"] = {
+                "pairs": len(err),
+                "aae_deg": float(err.mean()),
+                "median_deg": float(np.median(err)),
+                "p95_deg": float(np.percentile(err, 95)),
+            }
+    except (VideoError, ValueError) as err:
+        fail(str(err))
+    if as_json:
+        typer.echo(json.dumps(result, indent=2))
+        return
+    rows = [
+        ("cropping ratio", "cropping_ratio", "{:.3f}"),
+        ("distortion", "distortion", "{:.3f}"),
+        ("stability (translation)", "stability_translation", "{:.3f}"),
+        ("stability (rotation)", "stability_rotation", "{:.3f}"),
+        ("stability", "stability", "{:.3f}"),
+        ("ITF (dB)", "itf_db", "{:.2f}"),
+        ("frames", "frames", "{}"),
+    ]
+    typer.echo(f"{'metric':26s}{'original':>12s}{'stabilised':>12s}")
+    for label, key, fmt in rows:
+        a, b = fmt.format(result["original"][key]), fmt.format(result["stabilised"][key])
+        typer.echo(f"{label:26s}{a:>12s}{b:>12s}")
+    if "rotations" in result:
+        r = result["rotations"]
+        typer.echo(
+            f"rotation error vs truth: AAE {r['aae_deg']:.4f}°, median "
+            f"{r['median_deg']:.4f}°, p95 {r['p95_deg']:.4f}° over {r['pairs']} pairs"
+        )

@@ -1,0 +1,69 @@
+"""``stabilize rotations``: estimation only, each frame pair's rotation R_t."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from stabilize.cli.app import app, fail
+from stabilize.cli.options import (
+    DeviceOption,
+    FlowOption,
+    FocalOption,
+    FovOption,
+    OverwriteOption,
+    QuietOption,
+    RaftWeightsOption,
+    flow_settings,
+)
+
+
+@app.command(
+    epilog=(
+        "Examples:\n\n"
+        "  stabilize rotations clip.mp4 -o rotations.csv\n\n"
+        "  stabilize rotations clip.mp4 --gcsv clip.gcsv     # for Gyroflow\n\n"
+        "  stabilize rotations clip.mp4 -o rot.csv --flow raft --raft-weights raft-small.pth"
+    )
+)
+def rotations(
+    input_path: Path = typer.Argument(..., metavar="IN", help="A video."),
+    output: Path | None = typer.Option(
+        None, "-o", "--output", help="CSV: frame,t,rx,ry,rz,support."
+    ),
+    gcsv: Path | None = typer.Option(
+        None, help="Also (or only) write the rates as a Gyroflow .gcsv, for clips with no gyro."
+    ),
+    flow_name: FlowOption = "dis",
+    raft_weights: RaftWeightsOption = None,
+    device: DeviceOption = "cpu",
+    fov: FovOption = None,
+    focal: FocalOption = None,
+    overwrite: OverwriteOption = False,
+    quiet: QuietOption = False,
+) -> None:
+    """Estimate only: the camera rotation R_t of every frame pair (radians)."""
+    from rotation import so3
+    from stabilize.cli.bars import progress_bar
+    from stabilize.motion.estimate import estimate_rotations
+    from stabilize.motion.files import write_rotations
+    from stabilize.video import VideoError, atomic_output, probe
+
+    if output is None and gcsv is None:
+        fail("give -o rotations.csv and/or --gcsv out.gcsv")
+    settings = flow_settings(flow_name, raft_weights, device, fov=fov, focal=focal)
+    try:
+        info = probe(input_path)
+        with progress_bar("estimating", None, quiet=quiet) as advance:
+            track = estimate_rotations(input_path, info, settings, advance)
+        if output is not None:
+            with atomic_output(output, overwrite=overwrite) as tmp:
+                write_rotations(tmp, track.times[:-1], so3.log_so3(track.rotations), track.support)
+        if gcsv is not None:
+            from stabilize.gyro.export import write_gcsv
+
+            with atomic_output(gcsv, overwrite=overwrite) as tmp:
+                write_gcsv(tmp, track.times, track.rotations)
+    except (VideoError, ValueError, FileExistsError, RuntimeError) as err:
+        fail(str(err))

@@ -1,0 +1,119 @@
+"""``stabilize run IN OUT`` (or just ``stabilize IN OUT``): the main job."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+from pathlib import Path
+
+import typer
+
+from stabilize.cli.app import app, fail
+from stabilize.cli.options import (
+    ENCODING,
+    NO_PREVIEW,
+    CodecOption,
+    CrfOption,
+    CropOption,
+    DeviceOption,
+    FlowOption,
+    FocalOption,
+    FovOption,
+    GyroDriftOption,
+    GyroFormatOption,
+    GyroLpfOption,
+    JsonOption,
+    LensOption,
+    LockOption,
+    MaxZoomOption,
+    MethodOption,
+    OverwriteOption,
+    PresetOption,
+    PreviewOption,
+    QuietOption,
+    RaftWeightsOption,
+    ReadoutOption,
+    SizeOption,
+    SmoothOption,
+    job_settings,
+)
+from stabilize.settings import DEFAULTS
+
+
+@app.command(
+    "run",
+    epilog=(
+        "The main job; `stabilize IN OUT` is short for `stabilize run IN OUT`.\n\n"
+        "Examples:\n\n"
+        "  stabilize shaky.mp4 steady.mp4\n\n"
+        "  stabilize shaky.mp4 steady.mp4 --smooth 1.0 --max-zoom 1.3 --report report/\n\n"
+        "  stabilize drone.mp4 locked.mp4 --lock --crop dynamic\n\n"
+        "  stabilize gopro.mp4 out.mp4 --lens 'GoPro_HERO7 Black_Wide_16by9.json'\n\n"
+        "  stabilize in.mp4 out.mp4 --flow raft --raft-weights raft-small.pth --device cuda"
+    ),
+)
+def run(
+    ctx: typer.Context,
+    input_path: Path = typer.Argument(..., metavar="IN", help="The shaky video."),
+    output_path: Path = typer.Argument(..., metavar="OUT", help="Where to write the result."),
+    flow_name: FlowOption = DEFAULTS.flow,
+    raft_weights: RaftWeightsOption = None,
+    device: DeviceOption = DEFAULTS.device,
+    fov: FovOption = DEFAULTS.fov,
+    focal: FocalOption = DEFAULTS.focal,
+    lens: LensOption = None,
+    smooth: SmoothOption = DEFAULTS.smooth,
+    method: MethodOption = DEFAULTS.method,
+    lock: LockOption = False,
+    max_zoom: MaxZoomOption = DEFAULTS.max_zoom,
+    crop: CropOption = DEFAULTS.crop,
+    codec: CodecOption = ENCODING.codec,
+    crf: CrfOption = ENCODING.crf,
+    preset: PresetOption = ENCODING.preset,
+    report: Path | None = typer.Option(
+        None, help="Write rotations.csv, path.csv, trajectory.png and summary.json here."
+    ),
+    preview: PreviewOption = NO_PREVIEW,
+    size: SizeOption = None,
+    gyro: Path | None = typer.Option(
+        None, help="Stabilise from this gyro log (synchronised to the video) instead."
+    ),
+    gyro_format: GyroFormatOption = None,
+    gyro_offset: float | None = typer.Option(None, help="Gyro minus video clock, s."),
+    gyro_axes: str | None = typer.Option(None, help="IMU axis of camera x, y, z, e.g. YXz."),
+    gyro_lpf: GyroLpfOption = DEFAULTS.gyro_lpf,
+    gyro_drift: GyroDriftOption = DEFAULTS.gyro_drift,
+    readout_ms: ReadoutOption = None,
+    overwrite: OverwriteOption = False,
+    quiet: QuietOption = False,
+    as_json: JsonOption = False,
+) -> None:
+    """Stabilise a video: estimate each frame's rotation, smooth the path, warp, encode."""
+    from stabilize.cli.bars import progress_bar
+    from stabilize.pipeline import stabilize_video
+    from stabilize.video import VideoError
+
+    settings = job_settings(ctx.params)
+    with contextlib.ExitStack() as stack:
+
+        def bar(label: str, total: int | None):
+            return stack.enter_context(progress_bar(label, total, quiet=quiet))
+
+        try:
+            summary, planned = stabilize_video(
+                input_path, output_path, settings, overwrite=overwrite, progress=bar
+            )
+        except (VideoError, ValueError, FileExistsError, FileNotFoundError, RuntimeError) as err:
+            fail(str(err))
+    if report is not None:
+        from stabilize.evaluate.report import write_report
+
+        write_report(report, planned, summary)
+    if as_json:
+        typer.echo(json.dumps(summary, indent=2))
+    elif not quiet:
+        typer.echo(
+            f"{output_path}: {summary['frames']} frames, zoom {summary['zoom']:.3f}, "
+            f"{summary['fps']:.1f} fps",
+            err=True,
+        )

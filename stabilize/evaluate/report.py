@@ -1,0 +1,87 @@
+"""The ``--report DIR`` files: rotations.csv, path.csv, trajectory.png, summary.json."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from rotation import so3
+from stabilize.motion.files import write_rotations
+from stabilize.warp.camera_path import CameraPath
+
+
+def write_path(path: Path, planned: CameraPath) -> None:
+    """Per frame: t, raw and smoothed orientation (w,x,y,z), zoom, homography (9 entries)."""
+    raw = Rotation.from_matrix(planned.raw).as_quat(scalar_first=True)
+    smooth = Rotation.from_matrix(planned.smooth).as_quat(scalar_first=True)
+    with open(path, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(
+            [
+                "frame",
+                "t",
+                "raw_w",
+                "raw_x",
+                "raw_y",
+                "raw_z",
+                "smooth_w",
+                "smooth_x",
+                "smooth_y",
+                "smooth_z",
+                "zoom",
+                *(f"h{i}{j}" for i in range(3) for j in range(3)),
+            ]
+        )
+        for k, t in enumerate(planned.times):
+            writer.writerow(
+                [
+                    k,
+                    f"{t:.6f}",
+                    *(f"{v:.9f}" for v in raw[k]),
+                    *(f"{v:.9f}" for v in smooth[k]),
+                    f"{planned.zoom[k]:.6f}",
+                    *(f"{v:.9g}" for v in planned.homographies[k].ravel()),
+                ]
+            )
+
+
+def plot_trajectory(path: Path, planned: CameraPath) -> None:
+    """Raw against smoothed pitch, yaw and roll (the camera's own rotation, degrees)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    # The camera's own orientation is Oᵀ; its rotation vector is (pitch, yaw, roll).
+    raw = np.degrees(so3.log_so3(np.swapaxes(planned.raw, -1, -2)))
+    smooth = np.degrees(so3.log_so3(np.swapaxes(planned.smooth, -1, -2)))
+    fig, axes = plt.subplots(4, 1, figsize=(10, 9), sharex=True)
+    for ax, k, name in zip(axes, (1, 0, 2), ("yaw", "pitch", "roll"), strict=False):
+        ax.plot(planned.times, raw[:, k], lw=1, color="0.55", label="raw")
+        ax.plot(planned.times, smooth[:, k], lw=2, color="C0", label="smoothed")
+        ax.set_ylabel(f"{name} (°)")
+        ax.grid(alpha=0.3)
+    axes[0].legend(loc="upper left")
+    axes[3].plot(planned.times, planned.zoom, color="C3")
+    axes[3].set_ylabel("zoom")
+    axes[3].set_xlabel("time (s)")
+    axes[3].grid(alpha=0.3)
+    fig.suptitle("Camera orientation: raw and smoothed")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def write_report(folder: str | Path, planned: CameraPath, summary: dict) -> None:
+    """The run's report folder: rotations.csv, path.csv, trajectory.png, summary.json."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    rotvecs = so3.log_so3(planned.rotations)
+    write_rotations(folder / "rotations.csv", planned.times[:-1], rotvecs, planned.support)
+    write_path(folder / "path.csv", planned)
+    plot_trajectory(folder / "trajectory.png", planned)
+    (folder / "summary.json").write_text(json.dumps(summary, indent=2))

@@ -1,0 +1,62 @@
+"""The job's settings, and the one place their defaults are written.
+
+The command line takes its defaults from here (``DEFAULTS``), so ``stabilize IN OUT``
+and ``stabilize_video(IN, OUT)`` do the same thing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from stabilize.video.encode import Encoding
+
+# A phone's main camera is about 26 mm full-frame equivalent: 69° across the long side.
+DEFAULT_HFOV = 69.0
+# Crop at most 13% of each side: about what FFmpeg's vid.stab zooms to (optzoom=1). Where
+# removing all the shake would need more, the path keeps some of it
+# (:func:`stabilize.path.budget.respect_zoom_budget`); on our test clips that cost almost
+# no steadiness (street: 0.943 → 0.942).
+DEFAULT_MAX_ZOOM = 1.15
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Everything a stabilisation job can be told; every field has the default a
+    user gets from ``stabilize IN OUT``.
+
+    >>> Settings(smooth=1.0).max_zoom
+    1.15
+    """
+
+    flow: str = "dis"  # flow backend (flow.BACKENDS)
+    flow_options: dict = field(default_factory=dict)
+    fov: float | None = None  # horizontal field of view, degrees
+    focal: float | None = None  # pixels; overrides fov
+    smooth: float = 0.5  # smoothing time constant, s
+    method: str = "adaptive"  # smoothing method (stabilize.path.smoothing.METHODS)
+    max_zoom: float = DEFAULT_MAX_ZOOM
+    crop: str = "auto"  # zoom mode (stabilize.path.zoom.CROP_MODES)
+    max_deg: float = 15.0  # the estimator's search range per frame pair
+    preview: bool = False  # write original | stabilised side by side
+    gyro: str | None = None  # a gyro log: the path comes from it, synchronised to the video
+    gyro_format: str | None = None
+    gyro_offset: float | None = None
+    gyro_axes: tuple | None = None  # R_cam_imu as nested tuples
+    gyro_lpf: float | None = None  # Hz
+    readout_ms: float | str | None = None  # rolling shutter: ms, 'auto', or the log's value
+    gyro_drift: bool = False  # also fit a linear clock drift
+    lens: str | None = None  # a Gyroflow lens profile (OpenCV fisheye)
+    device: str = "cpu"  # where frames are warped: cpu (OpenCV) or cuda (kornia, batched)
+    size: tuple[int, int] | None = None  # output (H, W); default: the input's
+    encoding: Encoding = field(default_factory=Encoding)
+
+    def focal_px(self, width: int) -> float:
+        """The focal length in pixels for a frame ``width`` pixels wide."""
+        if self.focal is not None:
+            return float(self.focal)
+        from rotation.camera import focal_from_fov  # the estimator's package is heavy
+
+        return focal_from_fov(self.fov or DEFAULT_HFOV, width)
+
+
+DEFAULTS = Settings()

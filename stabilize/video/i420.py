@@ -1,0 +1,67 @@
+"""Frames as I420 (planar YUV 4:2:0), the layout H.264 stores; 8 bits (uint8) or 10
+(uint16, ``yuv420p10le``), so a 10-bit source stays 10 bits.
+
+Pass 2 decodes, warps and encodes in I420 rather than RGB: FFmpeg then converts no colours
+on either side, half as many bytes cross the pipes, and a warp touches 1.5 bytes per
+pixel instead of 3. A frame is one (3H/2, W) uint8 array: the luma plane (H, W), then the
+two chroma planes (H/2, W/2) one after the other. Both sides must be even.
+
+This module knows the layout only; warping the planes is :mod:`stabilize.warp.planes`.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+BLACK = (16, 128, 128)  # limited-range black: Y, U, V (8 bits; ×4 at 10 bits)
+
+
+def black(frame: NDArray) -> tuple[int, int, int]:
+    """Black for a frame's sample depth (uint16 frames carry 10 bits)."""
+    scale = 4 if frame.dtype == np.uint16 else 1
+    return tuple(v * scale for v in BLACK)
+
+
+def pipe_format(source_pix_fmt: str) -> str:
+    """The I420 pipe format that keeps a source's depth: 10 bits stay 10 bits."""
+    return "yuv420p10le" if "10" in source_pix_fmt else "yuv420p"
+
+
+def pipe_layout(pix_fmt: str, size: tuple[int, int]) -> tuple[tuple[int, ...], type]:
+    """(shape, dtype) of one raw frame of (H, W) pixels in FFmpeg's ``pix_fmt``: I420
+    (3H/2, W), 8 or 10 bits (``yuv420p10le``: uint16), else RGB (H, W, 3) uint8."""
+    h, w = size
+    if pix_fmt.startswith("yuv420p"):
+        return (h * 3 // 2, w), np.uint16 if pix_fmt.endswith("10le") else np.uint8
+    return (h, w, 3), np.uint8
+
+
+def supports(size: tuple[int, int]) -> bool:
+    """Whether an (H, W) frame can travel as I420 (both sides even)."""
+    return size[0] % 2 == 0 and size[1] % 2 == 0
+
+
+def split(frame: NDArray[np.uint8]) -> tuple[NDArray, NDArray, NDArray]:
+    """(Y, U, V) views of an I420 frame (3H/2, W)."""
+    h = frame.shape[0] * 2 // 3
+    w = frame.shape[1]
+    chroma = frame[h:].reshape(2, h // 2, w // 2)
+    return frame[:h], chroma[0], chroma[1]
+
+
+def join(y: NDArray, u: NDArray, v: NDArray) -> NDArray[np.uint8]:
+    """One I420 frame (3H/2, W) from its planes: the inverse of :func:`split`."""
+    h, w = y.shape
+    return np.concatenate([y, np.stack([u, v]).reshape(h // 2, w)])
+
+
+def hstack(a: NDArray[np.uint8], b: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """Two I420 frames side by side."""
+    return join(*(np.hstack([p, q]) for p, q in zip(split(a), split(b), strict=True)))
+
+
+def to_rgb(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """I420 (limited range, BT.601) → RGB (H, W, 3)."""
+    return cv2.cvtColor(frame, cv2.COLOR_YUV2RGB_I420)

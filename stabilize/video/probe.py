@@ -1,0 +1,92 @@
+"""What a video is: size, rate, rotation, codec, streams.
+
+Probing parses what ``ffmpeg -i`` reports, since the bundled FFmpeg of imageio-ffmpeg
+comes without ffprobe.
+"""
+
+from __future__ import annotations
+
+import re
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+
+from stabilize.video.binary import ffmpeg_exe
+
+
+class VideoError(ValueError):
+    """The input is missing, not a video, or unreadable; the message is one line."""
+
+
+@dataclass(frozen=True)
+class VideoInfo:
+    path: Path | str
+    width: int  # as displayed, after the container's rotation
+    height: int
+    fps: float
+    duration: float | None
+    rotation: int  # display rotation in degrees, counter-clockwise
+    has_audio: bool
+    codec: str
+    pix_fmt: str
+    input_args: tuple = ()  # FFmpeg input options, e.g. an image sequence's start number
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return (self.height, self.width)
+
+
+_VIDEO = re.compile(r"Stream #\S+.*?: Video: (\w+).*?, (\w+)(?:\([^)]*\))?, .*?(\d{2,5})x(\d{2,5})")
+_FPS = re.compile(r"(\d+(?:\.\d+)?) (?:fps|tbr)")
+_DURATION = re.compile(r"Duration: (\d+):(\d+):(\d+(?:\.\d+)?)")
+_ROTATION = re.compile(r"rotation of (-?\d+(?:\.\d+)?) degrees|rotate\s*:\s*(-?\d+)")
+
+
+def sequence_args(path: str | Path, start_number: int | None, fps: float | None) -> tuple:
+    """FFmpeg input options for an image sequence (a %d pattern), else none."""
+    if "%" not in str(path):
+        return ()
+    args = ("-f", "image2")
+    if start_number is not None:
+        args += ("-start_number", str(start_number))
+    return (*args, "-framerate", str(fps or 30.0))
+
+
+def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
+    """What FFmpeg reports of the first video stream, or :class:`VideoError`.
+
+    ``path`` may be an image-sequence pattern (``frames/img-%d.jpg``) with the input
+    options of :func:`sequence_args`.
+    """
+    pattern = "%" in str(path)
+    path = Path(path)
+    if not pattern and not path.exists():
+        raise VideoError(f"{path}: no such file")
+    if path.is_dir():
+        raise VideoError(f"{path}: is a folder, not a video (give a pattern like dir/img-%d.jpg)")
+    result = subprocess.run(
+        [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i", str(path)],
+        capture_output=True,
+        text=True,
+        errors="replace",
+    )
+    text = result.stderr
+    video = _VIDEO.search(text)
+    if video is None:
+        raise VideoError(f"{path}: not a video FFmpeg can read")
+    codec, pix_fmt, w, h = video.group(1), video.group(2), int(video.group(3)), int(video.group(4))
+    stream_line = text[video.start() : text.find("\n", video.start())]
+    fps_match = _FPS.search(stream_line)
+    fps = float(fps_match.group(1)) if fps_match else 0.0
+    dur = _DURATION.search(text)
+    duration = (
+        int(dur.group(1)) * 3600 + int(dur.group(2)) * 60 + float(dur.group(3)) if dur else None
+    )
+    rot = _ROTATION.search(text)
+    rotation = int(round(float(rot.group(1) or rot.group(2)))) % 360 if rot else 0
+    if rotation in (90, 270):
+        w, h = h, w
+    has_audio = re.search(r"Stream #\S+.*?: Audio:", text) is not None
+    return VideoInfo(
+        path, w, h, fps, duration, rotation, has_audio, codec, pix_fmt, tuple(input_args)
+    )

@@ -1,0 +1,76 @@
+"""The planned camera path of a clip, and how each of its frames is warped.
+
+A frame is warped by one homography, unless it must be warped by a map: through a lens
+profile, or row by row under a rolling shutter. On CUDA the plain homography warps of a
+batch run together (kornia); lens and rolling-shutter maps stay on the CPU.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from stabilize.video import i420
+from stabilize.warp.cuda import warp_frames_torch
+from stabilize.warp.frames import warp_frame
+from stabilize.warp.homography import homography
+from stabilize.warp.lens import Lens
+from stabilize.warp.planes import chroma_homography, remap_planes, warp_planes
+from stabilize.warp.remap import remap_from
+from stabilize.warp.sources import lens_source, rolling_source
+
+
+@dataclass
+class CameraPath:
+    """The estimated and the planned camera path of a clip."""
+
+    times: NDArray  # (N,) s
+    rotations: NDArray  # (N-1, 3, 3) R_t
+    support: NDArray  # (N-1,)
+    raw: NDArray  # (N, 3, 3) O_t
+    smooth: NDArray  # (N, 3, 3) S_t
+    zoom: NDArray  # (N,) applied zoom
+    homographies: NDArray  # (N, 3, 3) input → output pixels (the middle row's)
+    K: NDArray
+    # Rolling shutter: the corrections of each knot row (N, B, 3, 3) at input rows (B,).
+    row_corrections: NDArray | None = None
+    knot_rows: NDArray | None = None
+    lens: Lens | None = None  # fisheye: frames are warped through it, not by homographies
+
+    def warp_many(
+        self, batch: Sequence[tuple[int, NDArray[np.uint8]]], device: str = "cpu"
+    ) -> list[NDArray[np.uint8]]:
+        """Output frames of (k, frame) pairs, RGB or I420 (2-D); on CUDA the plain
+        homography warps run as one batch (lens and rolling-shutter maps stay on the CPU)."""
+        plain = self.lens is None and self.row_corrections is None
+        eight_bit = all(frame.dtype == np.uint8 for _, frame in batch)
+        if not (device.startswith("cuda") and plain and eight_bit):
+            return [self.warp(k, frame) for k, frame in batch]
+        H = self.homographies[[k for k, _ in batch]]
+        frames = np.stack([frame for _, frame in batch])
+        if frames.ndim == 4:
+            return list(warp_frames_torch(frames, H, device))
+        planes = [np.stack(p) for p in zip(*(i420.split(f) for f in frames), strict=True)]
+        Hc = np.array([chroma_homography(h) for h in H])
+        warped = [
+            warp_frames_torch(p, M, device, fill)
+            for p, M, fill in zip(planes, (H, Hc, Hc), i420.black(frames), strict=True)
+        ]
+        return [i420.join(*parts) for parts in zip(*warped, strict=True)]
+
+    def warp(self, k: int, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        """Frame k of the output, from frame k of the input (RGB, or I420 when 2-D)."""
+        planar = frame.ndim == 2
+        rolling = self.row_corrections is not None
+        if self.lens is None and not rolling:
+            H = self.homographies[k]
+            return warp_planes(frame, H) if planar else warp_frame(frame, H)
+        C = self.row_corrections[k] if rolling else self.smooth[k] @ self.raw[k].T
+        if self.lens is not None:
+            source = lens_source(self.lens, C, self.zoom[k], self.knot_rows)
+        else:
+            source = rolling_source(homography(self.K, C, self.zoom[k]), self.knot_rows)
+        return remap_planes(frame, source) if planar else remap_from(frame, source)

@@ -1,0 +1,83 @@
+"""Pass 2: decode at full size, warp each frame along the planned path, encode.
+
+Pass 2 stays in I420 from decoder to encoder where the sizes allow (both sides even):
+no colour conversion on either side, and half the bytes through the pipes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+from dataclasses import replace
+from itertools import islice
+from pathlib import Path
+
+import ffmpeg
+import numpy as np
+
+from stabilize.progress import Progress, no_progress
+from stabilize.settings import Settings
+from stabilize.video import FrameWriter, VideoInfo, i420, read_frames
+from stabilize.video.retime import is_variable_rate, retime
+from stabilize.warp.camera_path import CameraPath
+from stabilize.warp.frames import resize_image
+from stabilize.warp.planes import resize_planes
+
+WARP_BATCH = 8  # frames warped together on CUDA
+
+
+def render(
+    path: Path,
+    out: Path,
+    info: VideoInfo,
+    planned: CameraPath,
+    settings: Settings,
+    progress: Progress = no_progress,
+) -> int:
+    """Decode, warp, encode with the audio copied; returns frames written.
+
+    A variable-frame-rate clip is encoded at its nominal rate without B-frames, then its
+    packets are restamped with the source's own frame times (:func:`retime`).
+    """
+    audio = ffmpeg.input(str(path)).audio if info.has_audio else None
+    written = 0
+    fps = info.fps or 30.0
+    h, w = settings.size or info.size
+    size = (h, 2 * w) if settings.preview else (h, w)
+    variable = is_variable_rate(planned.times)
+    encoding = replace(settings.encoding, b_frames=False) if variable else settings.encoding
+    target = out.with_name(out.name + ".cfr.mp4") if variable else out
+    # I420 end to end where the size allows: no colour conversions, half the bytes.
+    planar = i420.supports(info.size) and i420.supports((h, w))
+    pix_fmt = i420.pipe_format(info.pix_fmt) if planar else "rgb24"
+    if pix_fmt == "yuv420p10le" and encoding.pix_fmt == "yuv420p":
+        encoding = replace(encoding, pix_fmt=pix_fmt)  # keep a 10-bit source's depth
+    side_by_side = i420.hstack if planar else lambda a, b: np.hstack([a, b])
+    resize = resize_planes if planar else resize_image
+    try:
+        with FrameWriter(
+            target, size, fps, encoding, audio, copy_audio=True, pix_fmt_in=pix_fmt
+        ) as writer:
+            decoded = read_frames(path, info=info, pix_fmt=pix_fmt)
+            frames = zip(range(len(planned.zoom)), decoded, strict=False)
+            for batch in batches(frames, WARP_BATCH if settings.device == "cuda" else 1):
+                for frame, warped in zip(
+                    (f for _, f in batch), planned.warp_many(batch, settings.device), strict=True
+                ):
+                    if settings.size:
+                        frame, warped = resize(frame, (h, w)), resize(warped, (h, w))
+                    writer.write(side_by_side(frame, warped) if settings.preview else warped)
+                    written += 1
+                    progress(1)
+        if variable:
+            retime(target, out, planned.times[:written])
+    finally:
+        if variable:
+            target.unlink(missing_ok=True)
+    return written
+
+
+def batches(items: Iterable, n: int) -> Iterator[list]:
+    """Consecutive lists of n items (the last may be shorter)."""
+    it = iter(items)
+    while batch := list(islice(it, n)):
+        yield batch

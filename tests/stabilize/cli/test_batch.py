@@ -1,0 +1,34 @@
+"""``stabilize batch``: its errors, and the options it shares with ``run``."""
+
+import typer
+from typer.testing import CliRunner
+
+from stabilize.cli import app
+from stabilize.video import probe
+from tests.stabilize.helpers import SAMPLE as SAMPLE_DIR
+
+SAMPLE = SAMPLE_DIR / "clip.mp4"
+
+
+def test_batch_errors():
+    result = CliRunner().invoke(app, ["batch", "no-such-folder", "out"])
+    assert result.exit_code != 0 and "not a folder" in result.output
+
+
+def test_batch_takes_every_option_of_the_single_file_command():
+    commands = typer.main.get_command(app).commands
+    names = {name: {p.name for p in commands[name].params} for name in ("run", "batch")}
+    per_file = {"input_path", "output_path", "report", "overwrite", "as_json"}
+    per_clip_gyro = {"gyro_offset", "gyro_axes"}  # each clip's log has its own
+    assert names["run"] - per_file - per_clip_gyro <= names["batch"]
+
+
+def test_batch_passes_the_options_on(tmp_path):
+    src = tmp_path / "in"
+    src.mkdir()
+    (src / "a.mp4").write_bytes(SAMPLE.read_bytes())
+    out = tmp_path / "out"
+    args = ["batch", str(src), str(out), "--size", "320x180", "--crop", "none", "-q"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert probe(out / "a.mp4").size == (180, 320)

@@ -1,0 +1,18 @@
+"""``stabilize evaluate``: the metrics of two clips, as text and JSON."""
+
+from typer.testing import CliRunner
+
+from stabilize.cli import app
+
+SMALL = {"size": (180, 320), "seconds": 3.0, "fps": 30.0, "crowd": 0, "seed": 3, "walk": 0}
+
+
+def test_evaluate_command(tmp_path):
+    sample = "samples/street"
+    result = CliRunner().invoke(app, ["evaluate", f"{sample}/clip.mp4", f"{sample}/clip.mp4",
+                                      "--truth", f"{sample}/truth.csv", "--rotations",
+                                      f"{sample}/truth.csv", "--json"])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert '"aae_deg": 0.0' in result.output
+    bad = CliRunner().invoke(app, ["evaluate", "README.md", f"{sample}/clip.mp4"])
+    assert bad.exit_code != 0 and "not a video" in bad.output

@@ -1,0 +1,19 @@
+"""Fixtures of the stabiliser's tests: a short rendered shaky clip, made once."""
+
+from pathlib import Path
+
+import pytest
+
+from stabilize.synth import SynthOptions, render_clip
+
+
+def render(folder: Path, **options) -> Path:
+    """A 2 s, 320×180 rendered clip (with audio) in ``folder``; options of SynthOptions."""
+    opts = SynthOptions(size=(180, 320), **{"seconds": 2.0, **options})
+    render_clip(folder, opts)
+    return folder / "clip.mp4"
+
+
+@pytest.fixture(scope="session")
+def shaky(tmp_path_factory) -> Path:
+    return render(tmp_path_factory.mktemp("shaky"), seed=11, shake_deg=1.5, crowd=4)

@@ -1,0 +1,57 @@
+import cv2
+import numpy as np
+import pytest
+
+from stabilize.evaluate.metrics import (
+    evaluate,
+    evaluate_pair,
+    low_frequency_share,
+    scale_and_distortion,
+)
+from stabilize.synth import SynthOptions, render_frames
+
+SMALL = {"size": (180, 320), "seconds": 3.0, "fps": 30.0, "crowd": 0, "seed": 3, "walk": 0}
+
+
+@pytest.fixture(scope="module")
+def shaken() -> list[np.ndarray]:
+    return [f for f, _ in render_frames(SynthOptions(shake_deg=2.0, **SMALL))]
+
+
+@pytest.fixture(scope="module")
+def panning() -> list[np.ndarray]:
+    return [f for f, _ in render_frames(SynthOptions(shake_deg=0.0, **SMALL))]
+
+
+def test_a_steady_clip_ranks_above_a_shaken_one(shaken, panning):
+    still = evaluate([shaken[0]] * len(shaken))
+    smooth, shaky = evaluate(panning), evaluate(shaken)
+    assert still.stability == 1.0 and still.itf_db == 100.0
+    assert smooth.stability > shaky.stability + 0.1
+    assert smooth.itf_db > shaky.itf_db + 3
+
+
+def test_a_zoomed_crop_ranks_below_an_uncropped_one(shaken):
+    def zoom(frame: np.ndarray, z: float) -> np.ndarray:
+        h, w = frame.shape[:2]
+        M = cv2.getRotationMatrix2D(((w - 1) / 2, (h - 1) / 2), 0.0, z)
+        return cv2.warpAffine(frame, M, (w, h), flags=cv2.INTER_LINEAR)
+
+    _, same = evaluate_pair(shaken, shaken)
+    _, cropped = evaluate_pair(shaken, [zoom(f, 1.25) for f in shaken])
+    assert same.cropping_ratio == pytest.approx(1.0, abs=0.01)
+    assert cropped.cropping_ratio == pytest.approx(0.8, abs=0.02)
+    assert cropped.distortion > 0.97
+
+
+def test_metric_building_blocks():
+    assert scale_and_distortion(np.diag([2.0, 0.5, 1.0])) == (1.0, 0.25)
+    t = np.arange(64)
+    assert low_frequency_share(np.sin(2 * np.pi * 2 * t / 64)) > 0.99
+    assert low_frequency_share(np.sin(2 * np.pi * 20 * t / 64)) < 0.01
+
+
+def test_registration_survives_featureless_frames():
+    blank = [np.full((90, 160, 3), 128, np.uint8)] * 10
+    _, m = evaluate_pair(blank, blank)
+    assert m.cropping_ratio == 1.0 and m.registration_failures > 0

@@ -1,0 +1,54 @@
+"""Helpers the tests share: single-frame forms of the vectorised library functions, and
+small synthetic inputs. Not part of the package: the library works on whole clips."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from rotation import so3
+from stabilize.warp.coverage import Framing
+from stabilize.warp.lens import Lens
+from stabilize.warp.remap import remap_from
+from stabilize.warp.sources import lens_source, rolling_source
+
+# The bundled sample: a rendered street clip with its truth, gyro log and frame times.
+SAMPLE = Path(__file__).resolve().parents[2] / "samples" / "street"
+
+
+def covers(K, C, zoom, size, rows=None, lens: Lens | None = None) -> bool:
+    """Whether one frame's output at ``zoom`` lies inside its warped input."""
+    return bool(Framing(K, size, rows, lens).covered(np.asarray(C)[None], np.array([zoom]))[0])
+
+
+def required_zoom(K, C, size, max_zoom: float = 4.0, rows=None, lens=None) -> float:
+    """One frame's least covering zoom."""
+    return float(Framing(K, size, rows, lens).required_zooms(np.asarray(C)[None], max_zoom)[0])
+
+
+def warp_frame_rolling(frame: NDArray, H: NDArray, rows: NDArray) -> NDArray:
+    """Warp by row-dependent homographies H (B, 3, 3) at input knot rows (B,)."""
+    return remap_from(frame, rolling_source(H, rows))
+
+
+def warp_frame_lens(frame: NDArray, lens: Lens, C: NDArray, zoom: float, rows=None) -> NDArray:
+    """Undistort → rotate → redistort in one remap."""
+    return remap_from(frame, lens_source(lens, C, zoom, rows))
+
+
+def from_rgb(rgb: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """RGB (H, W, 3) → I420 (limited range, BT.601)."""
+    return cv2.cvtColor(rgb, cv2.COLOR_RGB2YUV_I420)
+
+
+def shaky_path(n=120, seed=0, shake_deg=1.0, pan_deg_s=0.0):
+    """(times, O): a handheld orientation path at 30 fps, with an optional pan."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / 30.0
+    angles = np.radians(shake_deg) * rng.normal(size=(n, 3))
+    angles[:, 1] += np.radians(pan_deg_s) * t
+    O = so3.exp_so3(-angles)  # world → camera
+    return t, O

@@ -1,0 +1,86 @@
+"""Planning the path: the zoom budget, the bent path, the crop modes, long clips."""
+
+import numpy as np
+import pytest
+
+from rotation import so3
+from rotation.camera import intrinsics
+from stabilize.path.budget import respect_zoom_budget
+from stabilize.path.plan import plan_path
+from stabilize.path.zoom import choose_zoom
+from stabilize.settings import Settings
+from stabilize.warp.coverage import Framing
+from tests.stabilize.helpers import covers, shaky_path
+
+K = intrinsics(500.0, (360, 640))
+SIZE = (360, 640)
+
+
+@pytest.mark.parametrize("crop", ["auto", "dynamic"])
+def test_the_zoom_budget_is_never_broken(crop):
+    t, O = shaky_path(shake_deg=2.0)
+    R = O[1:] @ np.swapaxes(O[:-1], -1, -2)
+    planned = plan_path(
+        t, R, np.ones(len(R)), K, SIZE, Settings(max_zoom=1.1, crop=crop, smooth=1.0)
+    )
+    assert planned.zoom.max() <= 1.1 + 1e-9
+    C = planned.smooth @ np.swapaxes(planned.raw, -1, -2)
+    assert all(covers(K, c, z + 1e-6, SIZE) for c, z in zip(C, planned.zoom, strict=True))
+
+
+def test_one_jolt_bends_the_path_only_near_it_and_in_few_rounds():
+    # A steady 10 s path with one 4° jolt: only the frames within reach of the pull
+    # (4σ of it) may change, and the rounds stay well below PULL_ROUNDS.
+    t = np.arange(300) / 30.0
+    angles = np.zeros((300, 3))
+    angles[150, 1] = np.radians(4.0)
+    O = so3.exp_so3(angles)
+    S = np.repeat(np.eye(3)[None], 300, axis=0)
+    searched = []
+
+    def zoom_of(path, frames):
+        searched.append(len(frames))
+        return Framing(K, SIZE).required_zooms(path @ np.swapaxes(O[frames], -1, -2), 1.2)
+
+    bent, zoom = respect_zoom_budget(O, S, t, zoom_of, 1.1, 0.5)
+    assert zoom.max() <= 1.1
+    assert len(searched) < 200  # 150 here, far below PULL_ROUNDS
+    reach = 4 * 0.5 * 0.5 * 30  # 4σ of the pull, in frames
+    far = np.abs(np.arange(300) - 150) > reach + 1
+    assert np.array_equal(bent[far], S[far]) and not np.allclose(bent[150], S[150])
+    assert max(searched[1:-1]) <= 2 * reach + 3  # the rounds search locally (only the
+
+
+def test_dynamic_zoom_is_smooth_and_never_below_the_need():
+    t = np.arange(60) / 30.0
+    need = np.ones(60)
+    need[30] = 1.3
+    z = choose_zoom(need, t, "dynamic", max_zoom=1.5, smooth=0.3)
+    assert np.all(z >= need) and z[30] == pytest.approx(1.3)
+    assert np.abs(np.diff(z)).max() < 0.05
+
+
+def test_a_long_clip_plans_in_memory_that_grows_with_its_length_not_its_square():
+    import tracemalloc
+
+    n = 20_000  # 11 minutes at 30 fps: an (N, N) float matrix would take 3.2 GB
+    t = np.arange(n) / 30.0
+    angles = np.zeros((n, 3))
+    angles[::997, 1] = np.radians(4.0)  # a jolt every half minute
+    O = so3.exp_so3(angles)
+    S = np.repeat(np.eye(3)[None], n, axis=0)
+
+    def zoom_of(path, frames):  # 1 + the correction's angle: a cheap stand-in
+        return 1.0 + so3.angle(path @ np.swapaxes(O[frames], -1, -2))
+
+    need = np.ones(n)
+    need[::500] = 1.1
+    tracemalloc.start()
+    try:
+        z = choose_zoom(need, t, "dynamic", max_zoom=1.5, smooth=0.5)
+        _, zoom = respect_zoom_budget(O, S, t, zoom_of, 1.03, 0.5)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert np.all(z >= need) and zoom.max() <= 1.03
+    assert peak < 200e6, f"{peak / 1e6:.0f} MB"
