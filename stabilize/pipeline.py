@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
 
@@ -28,6 +29,8 @@ from stabilize.path.plan import plan_path
 from stabilize.progress import ProgressFactory, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoInfo, atomic_output, frame_times, probe
+from stabilize.video.containers import container_for
+from stabilize.video.streams import keep_streams
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.lens import Lens, read_lens_profile
 from stabilize.warp.render import render
@@ -40,16 +43,23 @@ def stabilize_video(
     *,
     overwrite: bool = False,
     progress: ProgressFactory | None = None,
+    notify: Callable[[str], None] | None = None,
 ) -> tuple[dict, CameraPath]:
     """Stabilise a clip into ``output_path`` (atomically); returns (summary, path).
 
+    The output's suffix chooses its container; every audio and subtitle track, the
+    chapters and the metadata are kept (:func:`stabilize.video.streams.keep_streams`).
     ``progress(label, total)`` gives each long stage its callback (``"estimating"``, then
-    ``"stabilising"``).
+    ``"stabilising"``); ``notify`` hears, before any work, of each track that had to be
+    converted or left out.
     """
     settings = settings or Settings()
     src, dst = Path(input_path), Path(output_path)
     _check_output(src, dst, overwrite)
     info = probe(src)
+    mux = keep_streams(info, container_for(dst), info.video_delay)
+    for notice in mux.notices:
+        (notify or (lambda _: None))(notice)
     start = time.perf_counter()
     bar = progress or (lambda label, total: no_progress)
     lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
@@ -70,7 +80,9 @@ def stabilize_video(
     planned = plan_path(track.times, R, track.support, K, info.size, settings, rolling, lens)
     t_plan = time.perf_counter() - start - t_estimate
     with atomic_output(dst, overwrite=overwrite) as tmp:
-        frames = render(src, tmp, info, planned, settings, bar("stabilising", len(track.times)))
+        frames = render(
+            src, tmp, info, planned, settings, bar("stabilising", len(track.times)), mux
+        )
     total = time.perf_counter() - start
     summary = {
         "input": str(src),
@@ -91,6 +103,7 @@ def stabilize_video(
         "fps": frames / total,
         "settings": {k: v for k, v in asdict(settings).items() if k != "encoding"},
         "gyro": gyro_summary,
+        "notices": list(mux.notices),
     }
     return summary, planned
 

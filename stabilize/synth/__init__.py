@@ -224,10 +224,9 @@ def render_clip(
     out.mkdir(parents=True, exist_ok=True)
     write_truth(out, opts)
     with atomic_output(out / "clip.mp4", overwrite=True) as tmp:
-        audio = sine_audio(opts.n_frames / opts.fps)
-        with FrameWriter(
-            tmp, opts.size, opts.fps, Encoding(crf=opts.crf, preset="veryfast"), audio
-        ) as writer:
+        tone = sine_audio(opts.n_frames / opts.fps)
+        encoding = Encoding(crf=opts.crf, preset="veryfast")
+        with FrameWriter(tmp, opts.size, opts.fps, encoding, tone) as writer:
             for frame, _ in render_frames(opts):
                 writer.write(frame)
                 if progress:

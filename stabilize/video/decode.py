@@ -67,43 +67,41 @@ def read_frames(
         raise VideoError(f"{path}: truncated: the file ends before its last frame")
 
 
+NOPTS = -(2**63)  # FFmpeg's AV_NOPTS_VALUE: a packet that carries no timestamp
+
+
 def frame_times(path: str | Path, input_args: tuple = ()) -> np.ndarray:
     """Presentation times (s) of every video frame, from the first, in display order.
 
     Read from the container's packets (no decoding), so variable frame rate is exact.
+    Where the packets carry no timestamps (AVI's MPEG-4 ASP, whose packets have only a
+    decoding order), the frames are decoded, cheaply (no pixels leave FFmpeg), and their
+    own times are taken instead.
     """
-    result = subprocess.run(
-        [
-            ffmpeg_exe(),
-            "-hide_banner",
-            "-nostdin",
-            *input_args,
-            "-i",
-            str(path),
-            "-map",
-            "0:v:0",
-            "-c",
-            "copy",
-            "-f",
-            "framecrc",
-            "-",
-        ],
-        capture_output=True,
-        text=True,
-        errors="replace",
-    )
+    times = _framecrc_times(path, input_args, decode=False)
+    if times is None:
+        times = _framecrc_times(path, input_args, decode=True)
+    if times is None:
+        raise VideoError(f"{path}: its frames carry no timestamps FFmpeg can read")
+    return times - times[0]
+
+
+def _framecrc_times(path: str | Path, input_args: tuple, *, decode: bool) -> np.ndarray | None:
+    """Sorted frame times from FFmpeg's framecrc of the first video stream: its packets
+    (``decode`` False) or its decoded frames; None where some carry no timestamp."""
+    codec = ["-c:v", "wrapped_avframe"] if decode else ["-c", "copy"]
+    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i", str(path)]
+    cmd += ["-map", "0:v:0", *codec, "-f", "framecrc", "-"]
+    result = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
     tb = re.search(r"#tb 0: (\d+)/(\d+)", result.stdout)
     if "partial file" in result.stderr:
         raise VideoError(f"{path}: truncated: the file ends before its last frame")
     if result.returncode != 0 or tb is None:
         raise VideoError(f"{path}: cannot read frame timestamps")
     scale = int(tb.group(1)) / int(tb.group(2))
-    pts = []
-    for line in result.stdout.splitlines():
-        if line.startswith("0,"):
-            fields = [f.strip() for f in line.split(",")]
-            pts.append(int(fields[2]))
+    pts = [int(line.split(",")[2]) for line in result.stdout.splitlines() if line.startswith("0,")]
     if not pts:
         raise VideoError(f"{path}: no video frames")
-    times = np.sort(np.array(pts, dtype=np.float64)) * scale
-    return times - times[0]
+    if NOPTS in pts or len(set(pts)) < len(pts):
+        return None
+    return np.sort(np.array(pts, dtype=np.float64)) * scale

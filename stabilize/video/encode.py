@@ -1,36 +1,91 @@
-"""Encoding frames with FFmpeg through a pipe (driven with ffmpeg-python)."""
+"""Encoding frames with FFmpeg through a pipe, into the container the output names.
+
+The frames arrive raw on FFmpeg's standard input (input 0); a :class:`Mux` adds the other
+inputs and says which of their streams go into the output and how (input 1 is the source
+clip, whose audio, subtitles, chapters and metadata are kept:
+:func:`stabilize.video.streams.keep_streams`).
+"""
 
 from __future__ import annotations
 
+import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
-import ffmpeg
 import numpy as np
 from numpy.typing import NDArray
 
 from stabilize.video.binary import ffmpeg_exe, widen_pipe
+from stabilize.video.containers import Container, container_for
+from stabilize.video.encoders import encoder_args
 from stabilize.video.i420 import pipe_layout
+
+
+class EncodeError(RuntimeError):
+    """The encoder failed while working; the message is FFmpeg's own last line."""
 
 
 @dataclass(frozen=True)
 class Encoding:
-    codec: str = "libx264"
-    crf: int = 18
+    """How the video stream is encoded. ``codec`` None: the container's default encoder
+    (libx264, or VP9 for WebM); ``crf`` None: that encoder's default quality (x264: 18)."""
+
+    codec: str | None = None
+    crf: int | None = None
     preset: str = "medium"
     pix_fmt: str = "yuv420p"
     threads: int = 0  # encoder threads; 0 lets the encoder choose (all cores)
     b_frames: bool = True  # off for variable-frame-rate output, whose packets are retimed
 
+    def codec_for(self, container: Container) -> str:
+        """The encoder to use in ``container``."""
+        return self.codec or container.video_encoder
+
+
+@dataclass(frozen=True)
+class Mux:
+    """What goes into the output beside the piped video: extra FFmpeg inputs (input 1
+    on), the arguments that map and encode their streams, what was changed or left out
+    (``notices``), and how late the video starts after the source's first stream (s)."""
+
+    inputs: tuple[tuple[str, ...], ...] = ()
+    args: tuple[str, ...] = ()
+    notices: tuple[str, ...] = ()
+    video_delay: float = 0.0
+
+
+def output_args(
+    path: str | Path, encoding: Encoding, container: Container | None = None
+) -> list[str]:
+    """The video encoder's and the container's arguments for an output ``path``."""
+    container = container or container_for(path)
+    codec = encoding.codec_for(container)
+    args = [*encoder_args(codec, encoding.crf, encoding.preset), "-pix_fmt", encoding.pix_fmt]
+    if encoding.threads:
+        args += ["-threads", str(encoding.threads)]
+    if not encoding.b_frames:
+        args += ["-bf", "0"]
+    if container.hevc_tag and codec in ("libx265", "hevc"):
+        args += ["-tag:v", container.hevc_tag]
+    args += list(container.options)
+    return [*args, "-f", container.muxer] if container.muxer else args
+
+
+DELAY_CLOCK = 90_000  # ticks per second of a delayed video's timestamps (MPEG's clock)
+
+
+def _delayed(delay: float) -> list[str]:
+    """Arguments that start the piped video ``delay`` s late, on a 90 kHz clock: the
+    pipe's own clock ticks in whole frames, which would round a 21 ms delay to 33."""
+    if abs(delay) <= 5e-4:
+        return []
+    shift = f"settb=1/{DELAY_CLOCK},setpts=PTS+{delay:.6f}/TB"
+    return ["-filter:v", shift, "-enc_time_base:v", f"1:{DELAY_CLOCK}"]
+
 
 class FrameWriter:
     """Streams RGB uint8 frames (or I420, with ``pix_fmt_in="yuv420p"``) into an encoder
-    process.
-
-    Constant frame rate ``fps``. An optional audio stream (ffmpeg-python) is muxed in:
-    copied untouched (``copy_audio``, for a source file's audio) or encoded to AAC and
-    cut to the video's length (for a generated tone).
-    """
+    process at a constant frame rate ``fps``, muxed with what ``mux`` adds."""
 
     def __init__(
         self,
@@ -38,53 +93,49 @@ class FrameWriter:
         size: tuple[int, int],
         fps: float,
         encoding: Encoding | None = None,
-        audio=None,
+        mux: Mux | None = None,
         *,
-        copy_audio: bool = False,
         pix_fmt_in: str = "rgb24",
+        container: Container | None = None,
     ) -> None:
-        encoding = encoding or Encoding()
+        encoding, mux = encoding or Encoding(), mux or Mux()
         h, w = size
+        self.path = Path(path)
         self.shape, self.dtype = pipe_layout(pix_fmt_in, size)
-        video = ffmpeg.input(
-            "pipe:", format="rawvideo", pix_fmt=pix_fmt_in, s=f"{w}x{h}", framerate=fps
-        )
-        streams = [video] if audio is None else [video, audio]
-        options = {
-            "vcodec": encoding.codec,
-            "crf": encoding.crf,
-            "preset": encoding.preset,
-            "pix_fmt": encoding.pix_fmt,
-            "format": "mp4",
-            "movflags": "+faststart",
-        }
-        if encoding.threads:
-            options["threads"] = encoding.threads
-        if not encoding.b_frames:
-            options["bf"] = 0
-        if audio is not None and copy_audio:
-            options.update(acodec="copy")
-        elif audio is not None:
-            options.update(acodec="aac", shortest=None)
-        self._process = (
-            ffmpeg.output(*streams, str(path), **options)
-            .global_args("-hide_banner", "-loglevel", "error", "-nostdin")
-            .overwrite_output()
-            .run_async(cmd=ffmpeg_exe(), pipe_stdin=True, pipe_stderr=True)
-        )
+        raw = ["-f", "rawvideo", "-pix_fmt", pix_fmt_in, "-s", f"{w}x{h}", "-framerate", str(fps)]
+        cmd = [ffmpeg_exe(), "-hide_banner", "-loglevel", "error", "-nostdin", "-y"]
+        cmd += [*raw, "-i", "pipe:"]
+        for extra in mux.inputs:
+            cmd += list(extra)
+        cmd += ["-map", "0:v", *mux.args, *_delayed(mux.video_delay)]
+        cmd += [*output_args(path, encoding, container), str(path)]
+        self._process = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
         widen_pipe(self._process.stdin)
 
     def write(self, frame: NDArray[np.uint8]) -> None:
         if frame.shape != self.shape or frame.dtype != self.dtype:
             want = f"{np.dtype(self.dtype)} {self.shape}"
             raise ValueError(f"frame must be {want}, got {frame.dtype} {frame.shape}")
-        self._process.stdin.write(np.ascontiguousarray(frame))  # its buffer, not a copy
+        try:
+            self._process.stdin.write(np.ascontiguousarray(frame))  # its buffer, not a copy
+        except (BrokenPipeError, OSError):
+            raise self._failure() from None
 
     def close(self) -> None:
-        self._process.stdin.close()
-        err = self._process.stderr.read().decode(errors="replace")
+        try:
+            self._process.stdin.close()
+        except (BrokenPipeError, OSError):
+            pass
         if self._process.wait() != 0:
-            raise RuntimeError(f"ffmpeg failed: {err.strip().splitlines()[-1] if err else '?'}")
+            raise self._failure()
+        self._process.stderr.close()
+
+    def _failure(self) -> EncodeError:
+        """The encoder's death as one line: its last message, the disk's state named."""
+        self._process.kill()
+        err = self._process.stderr.read().decode(errors="replace").strip()
+        self._process.wait()
+        return EncodeError(encoder_message(err, self._process.returncode))
 
     def __enter__(self) -> FrameWriter:
         return self
@@ -97,8 +148,17 @@ class FrameWriter:
             self._process.wait()
 
 
-def sine_audio(seconds: float, frequency: float = 440.0):
-    """A test tone as an ffmpeg-python input (lavfi), for clips that must carry audio."""
-    return ffmpeg.input(
-        f"sine=frequency={frequency}:duration={seconds:.3f}:sample_rate=48000", format="lavfi"
-    ).audio
+def encoder_message(stderr: str, code: int | None) -> str:
+    """FFmpeg's failure in one line: its first message (the cause; the later ones are
+    its threads winding down), and 'the disk is full' where it says so."""
+    first = stderr.splitlines()[0] if stderr else f"exit status {code}"
+    if "No space left on device" in stderr:
+        return f"the disk is full (FFmpeg: {first})"
+    return f"the encoder failed: {first}"
+
+
+def sine_audio(seconds: float, frequency: float = 440.0) -> Mux:
+    """A test tone as a second input, encoded to AAC and cut to the video's length, for
+    rendered clips that must carry audio."""
+    tone = f"sine=frequency={frequency}:duration={seconds:.3f}:sample_rate=48000"
+    return Mux((("-f", "lavfi", "-i", tone),), ("-map", "1:a", "-c:a", "aac", "-shortest"))

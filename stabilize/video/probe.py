@@ -19,7 +19,21 @@ class VideoError(ValueError):
 
 
 @dataclass(frozen=True)
+class Stream:
+    """One stream of the input as FFmpeg lists it: its index, kind, codec and language."""
+
+    index: int
+    kind: str  # "video", "audio", "subtitle", "data" or "attachment"
+    codec: str
+    language: str = ""
+    start: float | None = None  # s, where FFmpeg lists one apart from the file's
+    tag: str = ""  # the container's codec tag, e.g. 'avc1', 'text'
+
+
+@dataclass(frozen=True)
 class VideoInfo:
+    """What FFmpeg reports of a video: its first video stream, and every stream it has."""
+
     path: Path | str
     width: int  # as displayed, after the container's rotation
     height: int
@@ -30,16 +44,50 @@ class VideoInfo:
     codec: str
     pix_fmt: str
     input_args: tuple = ()  # FFmpeg input options, e.g. an image sequence's start number
+    streams: tuple[Stream, ...] = ()
+    start: float = 0.0  # the container's start time, s: its earliest stream's first timestamp
+    chapters: int = 0
 
     @property
     def size(self) -> tuple[int, int]:
         return (self.height, self.width)
 
+    @property
+    def video_delay(self) -> float:
+        """How late the first video stream starts after the file's first stream, s (a TS
+        recording's video often starts some ms after its audio)."""
+        video = next((s for s in self.streams if s.kind == "video"), None)
+        if video is None or video.start is None:
+            return 0.0
+        return max(video.start - self.start, 0.0)
+
+    def of_kind(self, kind: str) -> tuple[Stream, ...]:
+        """The streams of one kind ("audio", "subtitle", ...), in the file's order."""
+        return tuple(s for s in self.streams if s.kind == kind)
+
 
 _VIDEO = re.compile(r"Stream #\S+.*?: Video: (\w+).*?, (\w+)(?:\([^)]*\))?, .*?(\d{2,5})x(\d{2,5})")
 _FPS = re.compile(r"(\d+(?:\.\d+)?) (?:fps|tbr)")
 _DURATION = re.compile(r"Duration: (\d+):(\d+):(\d+(?:\.\d+)?)")
+_START = re.compile(r"Duration: [^\n]*?start: (-?\d+(?:\.\d+)?)")
+_STREAM = re.compile(
+    r"Stream #0:(\d+)(?:\[\w+\])?(?:\((\w+)\))?: (Video|Audio|Subtitle|Data|Attachment): (\w+)"
+)
 _ROTATION = re.compile(r"rotation of (-?\d+(?:\.\d+)?) degrees|rotate\s*:\s*(-?\d+)")
+
+
+def _stream(match: re.Match, text: str) -> Stream:
+    line = text[match.start() : text.find("\n", match.start())]
+    start = re.search(r", start (-?\d+(?:\.\d+)?)", line)
+    tag = re.search(r"\((\w+) / 0x[0-9A-Fa-f]+\)", line)
+    return Stream(
+        int(match.group(1)),
+        match.group(3).lower(),
+        match.group(4),
+        match.group(2) or "",
+        float(start.group(1)) if start else None,
+        tag.group(1) if tag else "",
+    )
 
 
 def sequence_args(path: str | Path, start_number: int | None, fps: float | None) -> tuple:
@@ -86,7 +134,21 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     rotation = int(round(float(rot.group(1) or rot.group(2)))) % 360 if rot else 0
     if rotation in (90, 270):
         w, h = h, w
-    has_audio = re.search(r"Stream #\S+.*?: Audio:", text) is not None
+    streams = tuple(_stream(m, text) for m in _STREAM.finditer(text))
+    has_audio = any(s.kind == "audio" for s in streams)
+    start = _START.search(text)
     return VideoInfo(
-        path, w, h, fps, duration, rotation, has_audio, codec, pix_fmt, tuple(input_args)
+        path,
+        w,
+        h,
+        fps,
+        duration,
+        rotation,
+        has_audio,
+        codec,
+        pix_fmt,
+        tuple(input_args),
+        streams,
+        float(start.group(1)) if start else 0.0,
+        len(re.findall(r"^\s+Chapter #", text, re.M)),
     )

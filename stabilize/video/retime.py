@@ -12,34 +12,51 @@ from numpy.typing import NDArray
 TIMESCALE = 90_000  # ticks per second of retimed video (MPEG's clock)
 
 
+CLOCK_SLACK = 1e-3  # s: a millisecond clock (MKV, WebM) rounds each time by up to 0.5 ms
+
+
 def is_variable_rate(times: NDArray, tolerance: float = 0.01) -> bool:
-    """Whether frame intervals differ from their median by more than ``tolerance`` of it."""
-    steps = np.diff(np.asarray(times, dtype=np.float64))
-    if steps.size < 2:
+    """Whether the frames depart from a constant rate: some time lies off the straight
+    line from the first to the last by more than ``tolerance`` of a frame interval, and
+    by more than a millisecond clock's rounding (``CLOCK_SLACK``)."""
+    times = np.asarray(times, dtype=np.float64)
+    if len(times) < 3:
         return False
-    median = float(np.median(steps))
-    return bool(np.max(np.abs(steps - median)) > tolerance * median)
+    step = (times[-1] - times[0]) / (len(times) - 1)
+    line = times[0] + step * np.arange(len(times))
+    return bool(np.max(np.abs(times - line)) > max(tolerance * step, CLOCK_SLACK))
 
 
-def retime(src: str | Path, dst: str | Path, times: NDArray) -> None:
+def retime(
+    src: str | Path, dst: str | Path, times: NDArray, muxer: str = "", start: float = 0.0
+) -> None:
     """Copy ``src`` (written at a constant rate, without B-frames) to ``dst`` with the
     video frames stamped at ``times`` (s, one per frame); other streams are copied as they
     are. No re-encoding: the packets are remuxed with new timestamps.
+
+    The first frame is stamped at ``start`` (s), where the source's video began after
+    its first stream. ``muxer`` names the output's format (empty: from its suffix). The
+    file's metadata and chapters come along.
 
     FFmpeg's command line cannot take per-frame timestamps for frames arriving through a
     pipe, so this step uses PyAV (FFmpeg's libraries) to rewrite them.
     """
     import av
 
-    times = np.asarray(times, dtype=np.float64) - float(times[0])
+    times = np.asarray(times, dtype=np.float64) - float(times[0]) + start
     ticks = np.round(times * TIMESCALE).astype(np.int64)
     step = np.arange(len(ticks))
     ticks = np.maximum.accumulate(ticks - step) + step  # strictly rising, as a muxer needs
     last = np.median(np.diff(ticks)) if len(ticks) > 1 else TIMESCALE // 30
     gaps = np.diff(ticks, append=ticks[-1] + last)
-    with av.open(str(src)) as inp, av.open(str(dst), "w", format="mp4") as out:
+    with av.open(str(src)) as inp, av.open(str(dst), "w", format=muxer or None) as out:
         video = inp.streams.video[0]
         streams = {s.index: out.add_stream_from_template(s) for s in inp.streams}
+        out.metadata.update(inp.metadata)
+        for s in inp.streams:
+            streams[s.index].metadata.update(s.metadata)
+        if inp.chapters():
+            out.set_chapters(inp.chapters())
         streams[video.index].time_base = Fraction(1, TIMESCALE)
         k = 0  # without B-frames, packets come in display order: the k-th is frame k
         for packet in inp.demux():

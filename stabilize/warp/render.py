@@ -11,12 +11,13 @@ from dataclasses import replace
 from itertools import islice
 from pathlib import Path
 
-import ffmpeg
 import numpy as np
 
 from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
 from stabilize.video import FrameWriter, VideoInfo, i420, read_frames
+from stabilize.video.containers import container_for
+from stabilize.video.encode import Mux
 from stabilize.video.retime import is_variable_rate, retime
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.frames import resize_image
@@ -32,20 +33,23 @@ def render(
     planned: CameraPath,
     settings: Settings,
     progress: Progress = no_progress,
+    mux: Mux | None = None,
 ) -> int:
-    """Decode, warp, encode with the audio copied; returns frames written.
+    """Decode, warp, encode into the container ``out``'s suffix names, with what ``mux``
+    keeps of the source (default: nothing but the video); returns frames written.
 
     A variable-frame-rate clip is encoded at its nominal rate without B-frames, then its
     packets are restamped with the source's own frame times (:func:`retime`).
     """
-    audio = ffmpeg.input(str(path)).audio if info.has_audio else None
+    mux = mux or Mux()
+    container = container_for(out)
     written = 0
     fps = info.fps or 30.0
     h, w = settings.size or info.size
     size = (h, 2 * w) if settings.preview else (h, w)
     variable = is_variable_rate(planned.times)
     encoding = replace(settings.encoding, b_frames=False) if variable else settings.encoding
-    target = out.with_name(out.name + ".cfr.mp4") if variable else out
+    target = out.with_name(f"{out.stem}.cfr{out.suffix}") if variable else out
     # I420 end to end where the size allows: no colour conversions, half the bytes.
     planar = i420.supports(info.size) and i420.supports((h, w))
     pix_fmt = i420.pipe_format(info.pix_fmt) if planar else "rgb24"
@@ -55,7 +59,7 @@ def render(
     resize = resize_planes if planar else resize_image
     try:
         with FrameWriter(
-            target, size, fps, encoding, audio, copy_audio=True, pix_fmt_in=pix_fmt
+            target, size, fps, encoding, mux, pix_fmt_in=pix_fmt, container=container
         ) as writer:
             decoded = read_frames(path, info=info, pix_fmt=pix_fmt)
             frames = zip(range(len(planned.zoom)), decoded, strict=False)
@@ -69,7 +73,7 @@ def render(
                     written += 1
                     progress(1)
         if variable:
-            retime(target, out, planned.times[:written])
+            retime(target, out, planned.times[:written], container.muxer, mux.video_delay)
     finally:
         if variable:
             target.unlink(missing_ok=True)

@@ -1,0 +1,111 @@
+"""Output containers: the suffix chooses one, and each says what it holds as it is.
+
+A stream the container cannot hold as it is gets transcoded (an audio track into the
+container's audio codec, a text subtitle into its subtitle format) with a notice; one it
+cannot hold at all (a bitmap subtitle in MP4, any subtitle in AVI) is left out with a
+notice. Nothing is dropped silently.
+
+Suffixes not in :data:`CONTAINERS` go to whatever FFmpeg muxer claims them, with the
+streams copied; the pre-flight check (:func:`stabilize.video.preflight.check_encoder`)
+refuses one that FFmpeg cannot write.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+# Text subtitle codecs (FFmpeg's names): these convert into one another.
+TEXT_SUBTITLES = frozenset({"mov_text", "subrip", "srt", "ass", "ssa", "webvtt", "text"})
+QUICKTIME_AUDIO = frozenset({"aac", "mp3", "alac", "ac3", "eac3", "opus", "flac"})
+QUICKTIME = ("-movflags", "+faststart+use_metadata_tags")  # moov first; keep custom tags
+
+
+@dataclass(frozen=True)
+class Container:
+    """An output container: FFmpeg's muxer, its default video encoder, and the audio and
+    subtitle codecs it holds as they are (None: any), with what others become (None:
+    left out)."""
+
+    muxer: str
+    video_encoder: str = "libx264"
+    audio: frozenset[str] | None = None
+    audio_encoder: str = "aac"
+    subtitles: frozenset[str] | None = None
+    subtitle_encoder: str | None = None
+    chapters: bool = True
+    options: tuple[str, ...] = ()
+    hevc_tag: str | None = None  # the codec tag Apple players need for HEVC
+
+    def audio_codec(self, codec: str) -> str:
+        """``copy`` for an audio codec held as it is, else the encoder it becomes."""
+        return "copy" if self.audio is None or codec in self.audio else self.audio_encoder
+
+    def subtitle_codec(self, codec: str) -> str | None:
+        """``copy``, the encoder a text subtitle becomes, or None: it cannot be held."""
+        if self.subtitles is None or codec in self.subtitles:
+            return "copy"
+        return self.subtitle_encoder if codec in TEXT_SUBTITLES else None
+
+
+# The registry: an output suffix → its container. Adding one is a line here.
+CONTAINERS: dict[str, Container] = {
+    ".mp4": Container(
+        "mp4",
+        audio=QUICKTIME_AUDIO,
+        subtitles=frozenset({"mov_text"}),
+        subtitle_encoder="mov_text",
+        options=QUICKTIME,
+        hevc_tag="hvc1",
+    ),
+    ".m4v": Container(
+        "mp4",
+        audio=QUICKTIME_AUDIO,
+        subtitles=frozenset({"mov_text"}),
+        subtitle_encoder="mov_text",
+        options=QUICKTIME,
+        hevc_tag="hvc1",
+    ),
+    ".mov": Container(
+        "mov",
+        audio=QUICKTIME_AUDIO | {"pcm_s16le", "pcm_s24le"},
+        subtitles=frozenset({"mov_text"}),
+        subtitle_encoder="mov_text",
+        options=QUICKTIME,
+        hevc_tag="hvc1",
+    ),
+    ".mkv": Container(
+        "matroska",
+        subtitles=frozenset(
+            {"subrip", "ass", "ssa", "webvtt", "hdmv_pgs_subtitle", "dvd_subtitle", "dvb_subtitle"}
+        ),
+        subtitle_encoder="srt",
+    ),
+    ".webm": Container(
+        "webm",
+        "libvpx-vp9",
+        frozenset({"opus", "vorbis"}),
+        "libopus",
+        frozenset({"webvtt"}),
+        "webvtt",
+    ),
+    ".avi": Container(
+        "avi",
+        audio=frozenset({"mp3", "mp2", "ac3", "pcm_s16le"}),  # not ADTS AAC
+        audio_encoder="libmp3lame",
+        subtitles=frozenset(),
+        chapters=False,
+    ),
+    ".ts": Container(
+        "mpegts",
+        audio=frozenset({"aac", "mp3", "mp2", "ac3", "eac3", "opus"}),
+        subtitles=frozenset({"dvb_subtitle"}),
+        chapters=False,
+    ),
+}
+
+
+def container_for(path: str | Path) -> Container:
+    """The container an output's suffix names (FFmpeg's own guess for other suffixes)."""
+    suffix = Path(path).suffix.lower()
+    return CONTAINERS.get(suffix) or Container("", subtitles=None)

@@ -1,0 +1,60 @@
+"""Video encoders: how each takes the job's quality and speed (``--crf``, ``--preset``).
+
+x264 and x265 take both as they are. The others get their own scales: VP9 constant
+quality needs ``-b:v 0``, and its speed is ``-cpu-used``; SVT-AV1 numbers its presets.
+An encoder not listed gets ``-crf`` and ``-preset`` as they are, and the pre-flight check
+(:func:`stabilize.video.preflight.check_encoder`) refuses what it does not take.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+# x264's preset names, slowest last, as a 0..1 scale for the encoders that number theirs.
+X264_PRESETS = (
+    "ultrafast", "superfast", "veryfast", "faster", "fast",
+    "medium", "slow", "slower", "veryslow", "placebo",
+)  # fmt: skip
+# The quality a user gets from the default --crf 18 of x264, per encoder's own scale.
+DEFAULT_CRF = {"libx264": 18, "libx265": 20, "libvpx-vp9": 31, "libsvtav1": 30, "libaom-av1": 30}
+
+
+def _speed(preset: str, slowest: int, fastest: int) -> int:
+    """An x264 preset name on an encoder's numbered speed scale (x264's medium → middle)."""
+    if preset.isdigit():
+        return int(preset)
+    rank = X264_PRESETS.index(preset) / (len(X264_PRESETS) - 1) if preset in X264_PRESETS else 0.5
+    return round(fastest + rank * (slowest - fastest))
+
+
+def _x26x(crf: int, preset: str) -> list[str]:
+    return ["-crf", str(crf), "-preset", preset]
+
+
+def _vp9(crf: int, preset: str) -> list[str]:
+    return ["-crf", str(crf), "-b:v", "0", "-deadline", "good", "-row-mt", "1",
+            "-cpu-used", str(_speed(preset, 0, 5))]  # fmt: skip
+
+
+def _svtav1(crf: int, preset: str) -> list[str]:
+    return ["-crf", str(crf), "-preset", str(_speed(preset, 2, 12))]
+
+
+def _aom(crf: int, preset: str) -> list[str]:
+    return ["-crf", str(crf), "-cpu-used", str(_speed(preset, 1, 8)), "-row-mt", "1"]
+
+
+# The registry: an encoder's name → its arguments for (crf, preset).
+ENCODERS: dict[str, Callable[[int, str], list[str]]] = {
+    "libx264": _x26x,
+    "libx265": _x26x,
+    "libvpx-vp9": _vp9,
+    "libsvtav1": _svtav1,
+    "libaom-av1": _aom,
+}
+
+
+def encoder_args(codec: str, crf: int | None, preset: str) -> list[str]:
+    """FFmpeg's arguments for ``codec`` at quality ``crf`` (None: the codec's default)."""
+    quality = DEFAULT_CRF.get(codec, 18) if crf is None else crf
+    return ["-c:v", codec, *ENCODERS.get(codec, _x26x)(quality, preset)]

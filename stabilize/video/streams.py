@@ -1,0 +1,75 @@
+"""Keeping what the user gave us: every audio and subtitle track of the source, its
+chapters and its metadata, muxed beside the stabilised video.
+
+Each track is copied when the output container holds it as it is, transcoded when it
+does not (AAC into WebM becomes Opus, mov_text into MKV becomes SRT), and left out only
+when the container cannot hold it at all, with a notice saying so. Per-stream metadata
+(language, title) comes with each track; the file's (creation time, location, title)
+and the video stream's own come from the source. The display rotation does not: the
+frames are written upright.
+"""
+
+from __future__ import annotations
+
+from stabilize.video.containers import Container
+from stabilize.video.encode import Mux
+from stabilize.video.probe import Stream, VideoInfo
+
+KEPT = ("audio", "subtitle")  # the kinds of stream carried over from the source
+
+
+def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0) -> Mux:
+    """The :class:`Mux` that carries the source's tracks, chapters and metadata over.
+
+    ``video_delay`` (s): how late the source's video starts after its first stream, so
+    that audio stays in sync.
+    """
+    if info.input_args:  # an image sequence: no other streams, no metadata
+        return Mux()
+    args: list[str] = []
+    notices: list[str] = []
+    count = {"audio": 0, "subtitle": 0}
+    kept: list[int] = []
+    for stream in info.streams:
+        if stream.kind not in KEPT:
+            if not _rebuilt(stream, info):
+                notices.append(f"left out {stream.kind} stream #{stream.index} ({stream.codec})")
+            continue
+        if stream.kind == "audio":
+            codec = container.audio_codec(stream.codec)
+        else:
+            codec = container.subtitle_codec(stream.codec)
+        where = _name(container)
+        if codec is None:
+            notices.append(
+                f"left out subtitle #{stream.index} ({stream.codec}): {where} cannot hold it"
+            )
+            continue
+        if codec != "copy":
+            notices.append(f"{stream.kind} #{stream.index}: {stream.codec} → {codec} for {where}")
+        flag = "a" if stream.kind == "audio" else "s"
+        args += ["-map", f"1:{stream.index}", f"-c:{flag}:{count[stream.kind]}", codec]
+        count[stream.kind] += 1
+        kept.append(stream.index)
+    # One mapping per stream: any explicit one turns FFmpeg's per-stream default off.
+    args += ["-map_metadata", "1", "-map_metadata:s:0", f"1:s:{_first_video(info)}"]
+    for out, index in enumerate(kept, start=1):
+        args += [f"-map_metadata:s:{out}", f"1:s:{index}"]
+    args += ["-map_chapters", "1" if container.chapters else "-1"]
+    return Mux((("-i", str(info.path)),), tuple(args), tuple(notices), video_delay)
+
+
+def _rebuilt(stream: Stream, info: VideoInfo) -> bool:
+    """Whether a stream not carried over is in the output anyway: the video itself, or
+    MP4's chapter text track (the chapters are written from the chapter list)."""
+    if stream.kind == "video":
+        return stream.index == _first_video(info)
+    return stream.kind == "data" and stream.tag == "text" and info.chapters > 0
+
+
+def _first_video(info: VideoInfo) -> int:
+    return next((s.index for s in info.streams if s.kind == "video"), -1)
+
+
+def _name(container: Container) -> str:
+    return container.muxer.upper() if container.muxer else "this container"
