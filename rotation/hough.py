@@ -34,9 +34,10 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
-from numba import get_num_threads, njit, prange
+from numba import get_num_threads, njit
 from numpy.typing import NDArray
 
 from rotation.camera import default_center
@@ -137,15 +138,31 @@ class HoughEstimator:
         return self._result(R, count, inliers, valid)
 
     def estimate_many(self, flows: NDArray) -> list[RotationEstimate]:
-        """Rotations of a stack (N, H, W, 2), in parallel over the available cores."""
+        """Rotations of a stack (N, H, W, 2), in parallel over the available cores.
+
+        The fields are dealt out in interleaved chunks, two per thread, each with an
+        accumulator of its own; the kernel releases the GIL, so plain threads run the
+        chunks side by side. (A numba ``prange`` kernel did the same as fast, but took
+        twice as long to compile on the first run: 21 s against 11 s.)
+        """
         flows = check_flows(flows, self.size, stacked=True)
         u, v, valid = sample_flows(flows, self.grid)
-        Rs, counts, inliers = estimate_batch(
-            *self._field_args(u, v, valid),
-            self._n_max,
-            self._touched_len,
-            min(len(u), 2 * get_num_threads()),
-        )
+        n = len(u)
+        threads = max(1, min(n, get_num_threads()))
+        chunks = min(n, 2 * threads)
+        Rs = np.empty((n, 3, 3))
+        counts = np.zeros(n, np.int64)
+        inliers = np.zeros(u.shape, np.bool_)
+        args = self._field_args(u, v, valid)
+
+        def run(c: int) -> None:
+            acc = np.zeros(self._n_max**3, np.int32)
+            touched = np.empty(self._touched_len, np.int64)
+            picks = np.arange(c, n, chunks)
+            estimate_chunk(*args, acc, touched, picks, Rs, counts, inliers)
+
+        with ThreadPoolExecutor(threads) as pool:
+            list(pool.map(run, range(chunks)))
         return [self._result(*item) for item in zip(Rs, counts, inliers, valid, strict=True)]
 
     def _field_args(self, u: NDArray, v: NDArray, valid: NDArray) -> tuple:
@@ -283,21 +300,16 @@ def curve_inliers(xp, yp, qx, qy, valid, f, s, half, n, b) -> np.ndarray:
     return out
 
 
-@njit(cache=True, parallel=True)
-def estimate_batch(x, y, u, v, valid, f, levels, model, do_refine, n_max, touched_len, n_chunks):
-    """estimate_field over a stack, in n_chunks interleaved chunks with an accumulator each."""
-    n_fields = u.shape[0]
-    Rs = np.empty((n_fields, 3, 3))
-    counts = np.zeros(n_fields, np.int64)
-    inliers = np.zeros(u.shape, np.bool_)
-    for c in prange(n_chunks):
-        acc = np.zeros(n_max**3, np.int32)
-        touched = np.empty(touched_len, np.int64)
-        for i in range(c, n_fields, n_chunks):
-            R, count, mask = estimate_field(
-                x, y, u[i], v[i], valid[i], f, levels, model, do_refine, acc, touched
-            )
-            Rs[i] = R
-            counts[i] = count
-            inliers[i] = mask
-    return Rs, counts, inliers
+@njit(cache=True, nogil=True)
+def estimate_chunk(
+    x, y, u, v, valid, f, levels, model, do_refine, acc, touched, picks, Rs, counts, inliers
+) -> None:
+    """estimate_field for the fields ``picks`` of a stack, with one accumulator, into
+    Rs, counts and inliers; without the GIL, so that threads run chunks side by side."""
+    for i in picks:
+        R, count, mask = estimate_field(
+            x, y, u[i], v[i], valid[i], f, levels, model, do_refine, acc, touched
+        )
+        Rs[i] = R
+        counts[i] = count
+        inliers[i] = mask

@@ -22,7 +22,7 @@ The names are imported when first used, so ``import stabilize`` stays cheap.
 
 from __future__ import annotations
 
-import importlib
+from stabilize.lazy import lazy_exports
 
 _EXPORTS = {
     "Settings": "stabilize.settings",
@@ -40,12 +40,4 @@ _EXPORTS = {
 
 __all__ = sorted(_EXPORTS)
 
-
-def __getattr__(name: str):
-    if name not in _EXPORTS:
-        raise AttributeError(f"module 'stabilize' has no attribute {name!r}")
-    return getattr(importlib.import_module(_EXPORTS[name]), name)
-
-
-def __dir__() -> list[str]:
-    return sorted([*globals(), *_EXPORTS])
+__getattr__, __dir__ = lazy_exports("stabilize", _EXPORTS)

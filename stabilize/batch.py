@@ -11,6 +11,7 @@ time match the manifest are skipped.
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import multiprocessing as mp
 import os
@@ -20,10 +21,11 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from stabilize.gyro.readers import GYRO_SIDECARS
 from stabilize.video import atomic_output
+from stabilize.video.atomic import sweep_stale
 
 MANIFEST = "manifest.json"
-GYRO_SIDECARS = (".gcsv", ".csv", ".txt")
 BYTES_PER_WORKER = 1.5 * 2**30  # the pipeline's peak at 1080p, with headroom
 FRAME_REPORT = 10  # frames a worker counts before it reports them
 THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")
@@ -45,8 +47,10 @@ def find_jobs(
     pattern: str = "*",
     recursive: bool = False,
     gyro_auto: bool = False,
+    suffix: str | None = None,
 ) -> list[Job]:
-    """One job per matching file, the output mirroring its place in the input tree."""
+    """One job per matching file, the output mirroring its place in the input tree, with
+    the input's suffix (so its container) or ``suffix`` (``--format``)."""
     in_dir, out_dir = Path(in_dir).resolve(), Path(out_dir).resolve()
     paths = in_dir.rglob(pattern) if recursive else in_dir.glob(pattern)
     jobs = []
@@ -69,7 +73,7 @@ def find_jobs(
             Job(
                 str(rel),
                 str(path),
-                str(out_dir / rel),
+                str(out_dir / (rel.with_suffix(suffix) if suffix else rel)),
                 stat.st_size,
                 stat.st_mtime,
                 str(sidecar) if sidecar else None,
@@ -112,15 +116,28 @@ def write_manifest(out_dir: Path, rows: dict[str, dict]) -> None:
             writer.writerows(ordered)
 
 
-def is_complete(job: Job, row: dict | None) -> bool:
-    """Done before, from this very input, and the output is still there."""
+def is_complete(job: Job, row: dict | None, key: str = "") -> bool:
+    """Done before, from this very input, with the same settings (``key``), and the
+    output is still there."""
     return (
         row is not None
         and row.get("status") in ("done", "skipped")
         and row.get("size") == job.size
         and row.get("mtime") == job.mtime
+        and row.get("settings") == key
         and Path(job.output).is_file()
     )
+
+
+def settings_key(settings) -> str:
+    """A short hash of every setting that shapes an output (not the encoder's threads,
+    which a batch sets itself per worker)."""
+    from stabilize.pipeline import settings_summary
+
+    summary = settings_summary(settings)
+    summary["encoding"].pop("threads", None)
+    text = json.dumps(summary, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
 _FRAMES = None  # a worker's queue for frame counts, set by _start_worker
@@ -167,6 +184,7 @@ def run_job(job: Job, settings, on_frames: Callable[[int], None] | None = None) 
 
     start = time.perf_counter()
     row = {"input": job.input, "output": job.output, "size": job.size, "mtime": job.mtime}
+    row["settings"] = settings_key(settings)
     try:
         if job.gyro:
             settings = replace(settings, gyro=job.gyro)
@@ -218,8 +236,12 @@ def run_batch(
     on_done: Callable[[dict], None] | None = None,
     ray_address: str | None = None,
     on_frames: Callable[[int], None] | None = None,
+    *,
+    force: bool = False,
 ) -> list[dict]:
-    """Run the jobs not already complete; returns every job's row, in input order.
+    """Run the jobs not already complete (all of them with ``force``); returns every
+    job's row, in input order. A job counts as complete when the same input was done
+    with the same settings (a hash of them is kept in the manifest).
 
     ``on_done(row)`` hears of every file as it finishes, ``on_frames(n)`` of frames
     written (local workers; Ray tasks report files only).
@@ -229,13 +251,13 @@ def run_batch(
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    for stale in out_dir.rglob(".*.partial*"):
-        stale.unlink(missing_ok=True)  # left by a killed run; never under a final name
+    sweep_stale(out_dir, recursive=True)  # a killed run's leftovers, never a running one's
     previous = load_manifest(out_dir)
+    key = settings_key(settings)
     rows: dict[str, dict] = {}
     todo = []
     for job in jobs:
-        if is_complete(job, previous.get(job.input)):
+        if not force and is_complete(job, previous.get(job.input), key):
             rows[job.input] = {**previous[job.input], "status": "skipped", "seconds": 0.0}
             if on_done:
                 on_done(rows[job.input])

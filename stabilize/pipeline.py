@@ -15,25 +15,43 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
+import flow
 from rotation import so3
 from rotation.camera import intrinsics
+from stabilize.gyro.log import GyroLog
 from stabilize.motion.estimate import READOUT_BANDS, estimate_rotations
 from stabilize.motion.repair import repair_unreliable
+from stabilize.motion.track import VisualTrack
 from stabilize.path.plan import plan_path
+from stabilize.path.smoothing import METHODS
+from stabilize.path.zoom import CROP_MODES
 from stabilize.progress import ProgressFactory, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoInfo, atomic_output, frame_times, probe
 from stabilize.video.containers import container_for
+from stabilize.video.encode import EncodeError, Mux
+from stabilize.video.preflight import check_encoder, check_writable, describe
 from stabilize.video.streams import keep_streams
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.lens import Lens, read_lens_profile
-from stabilize.warp.render import render
+from stabilize.warp.render import encoded_size, frame_size, render
+
+
+@dataclass(frozen=True)
+class Job:
+    """A checked job: everything known about it before any frame is decoded."""
+
+    info: VideoInfo
+    lens: Lens | None
+    log: GyroLog | None
+    mux: Mux
+    notices: tuple[str, ...]
 
 
 def stabilize_video(
@@ -49,46 +67,40 @@ def stabilize_video(
 
     The output's suffix chooses its container; every audio and subtitle track, the
     chapters and the metadata are kept (:func:`stabilize.video.streams.keep_streams`).
-    ``progress(label, total)`` gives each long stage its callback (``"estimating"``, then
-    ``"stabilising"``); ``notify`` hears, before any work, of each track that had to be
-    converted or left out.
+    Every option, the paths, the encoder and the gyro log are checked before any frame
+    is decoded (:func:`prepare`). ``progress(label, total)`` gives each long stage its
+    callback (``"estimating"``, then ``"stabilising"``); ``notify`` hears, before any
+    work, of each track that had to be converted or left out.
     """
     settings = settings or Settings()
     src, dst = Path(input_path), Path(output_path)
-    _check_output(src, dst, overwrite)
-    info = probe(src)
-    mux = keep_streams(info, container_for(dst), info.video_delay)
-    for notice in mux.notices:
+    job = prepare(src, dst, settings, overwrite)
+    for notice in (*job.notices, *compiling_notice()):
         (notify or (lambda _: None))(notice)
     start = time.perf_counter()
     bar = progress or (lambda label, total: no_progress)
-    lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
     bands = READOUT_BANDS if settings.gyro and settings.readout_ms == "auto" else 0
-    times = frame_times(src, info.input_args)
+    times = frame_times(src, job.info.input_args)
     estimating = bar("estimating", max(len(times) - 1, 0))
-    track = estimate_rotations(src, info, settings, estimating, times, bands=bands, lens=lens)
-    gyro_summary, rolling, repaired = None, None, 0
-    if settings.gyro:
-        from stabilize.gyro.path import gyro_path  # gyro mode only
-
-        R, rolling, gyro_summary = gyro_path(settings, track, info.height, lens)
-    else:
-        R, reliable = repair_unreliable(track.rotations, track.support)
-        repaired = int((~reliable).sum())
+    track = estimate_rotations(
+        src, job.info, settings, estimating, times, bands=bands, lens=job.lens
+    )
+    R, rolling, repaired, gyro_summary = _rotations(settings, job, track)
     t_estimate = time.perf_counter() - start
-    K = _camera_matrix(settings, info, lens)
-    planned = plan_path(track.times, R, track.support, K, info.size, settings, rolling, lens)
+    K = _camera_matrix(settings, job.info, job.lens)
+    planned = plan_path(
+        track.times, R, track.support, K, job.info.size, settings, rolling, job.lens
+    )
     t_plan = time.perf_counter() - start - t_estimate
-    with atomic_output(dst, overwrite=overwrite) as tmp:
-        frames = render(
-            src, tmp, info, planned, settings, bar("stabilising", len(track.times)), mux
-        )
+    frames = _write(
+        src, dst, job, planned, settings, bar("stabilising", len(track.times)), overwrite
+    )
     total = time.perf_counter() - start
     summary = {
         "input": str(src),
         "output": str(dst),
         "frames": frames,
-        "size": [info.width, info.height],
+        "size": [job.info.width, job.info.height],
         "focal_px": float(K[0, 0]),
         "zoom": float(planned.zoom.max()),
         "mean_support": float(np.mean(track.support)),
@@ -101,11 +113,103 @@ def stabilize_video(
             "total": total,
         },
         "fps": frames / total,
-        "settings": {k: v for k, v in asdict(settings).items() if k != "encoding"},
+        "settings": settings_summary(settings),
         "gyro": gyro_summary,
-        "notices": list(mux.notices),
+        "notices": list(job.notices),
     }
     return summary, planned
+
+
+def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
+    """Every check that can be made before decoding: the options, the input, the output
+    folder, the encoder with these options in this container, the lens profile and the
+    gyro log. Raises ValueError (its subclasses name the file) on the first problem."""
+    _check_output(src, dst, overwrite)
+    check_settings(settings)
+    info = probe(src)
+    check_writable(dst)
+    check_encoder(dst, settings.encoding, encoded_size(info, settings))
+    lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
+    log = None
+    if settings.gyro:
+        from stabilize.gyro.path import load_gyro
+
+        log = load_gyro(settings, len(frame_times(src, info.input_args)))
+    mux = keep_streams(info, container_for(dst), info.video_delay)
+    notices = mux.notices
+    if not settings.size and frame_size(info, settings) != info.size:
+        h, w = frame_size(info, settings)
+        notices += (
+            f"{info.width}x{info.height} has an odd side: the output is {w}x{h}, the last "
+            "row or column cropped (4:2:0 video needs even sides)",
+        )
+    return Job(info, lens, log, mux, notices)
+
+
+def compiling_notice() -> tuple[str, ...]:
+    """A notice, the first time only, that the estimator's kernels are being compiled."""
+    from rotation.cache import cache_dir, kernels_cached
+
+    if kernels_cached():
+        return ()
+    return (f"compiling the estimator's kernels: about 15 s, once (cached in {cache_dir()})",)
+
+
+def _rotations(settings: Settings, job: Job, track: VisualTrack) -> tuple:
+    """(R_t, rolling-shutter turns or None, frames repaired, gyro summary or None): from
+    the gyro log when there is one, else the visual track with unreliable frames repaired."""
+    if job.log is not None:
+        from stabilize.gyro.path import gyro_path  # gyro mode only
+
+        R, rolling, summary = gyro_path(settings, job.log, track, job.info.height, job.lens)
+        return R, rolling, 0, summary
+    R, reliable = repair_unreliable(track.rotations, track.support)
+    return R, None, int((~reliable).sum()), None
+
+
+def _write(
+    src: Path, dst: Path, job: Job, planned: CameraPath, settings: Settings, progress, overwrite
+) -> int:
+    """Pass 2 into a temporary file beside ``dst``, renamed at the end; a failure names
+    ``dst``, never the temporary file."""
+    with atomic_output(dst, overwrite=overwrite) as tmp:
+        try:
+            return render(src, tmp, job.info, planned, settings, progress, job.mux)
+        except EncodeError as err:
+            raise EncodeError(str(err).replace(str(tmp), str(dst))) from None
+        except OSError as err:
+            raise EncodeError(f"cannot write {dst}: {describe(err)}") from None
+
+
+def check_settings(settings: Settings) -> None:
+    """Each setting within its range and among its choices; the error names the option."""
+    checks = [
+        (settings.flow in flow.BACKENDS, f"--flow must be one of {', '.join(flow.BACKENDS)}"),
+        (settings.method in METHODS, f"--method must be one of {', '.join(METHODS)}"),
+        (settings.crop in CROP_MODES, f"--crop must be one of {', '.join(CROP_MODES)}"),
+        (settings.device in ("cpu", "cuda"), "--device must be cpu or cuda"),
+        (settings.fov is None or 0 < settings.fov < 180, "--fov must be between 0 and 180°"),
+        (settings.focal is None or settings.focal > 0, "--focal must be a positive number"),
+        (settings.smooth > 0, "--smooth must be positive"),
+        (settings.max_zoom >= 1.0, "--max-zoom must be at least 1"),
+        (settings.gyro_search >= 0, "--gyro-search must not be negative"),
+        (
+            settings.size is None or all(v % 2 == 0 for v in settings.size),
+            "--size needs even sides (4:2:0 video)",
+        ),
+    ]
+    for ok, message in checks:
+        if not ok:
+            raise ValueError(message)
+
+
+def settings_summary(settings: Settings) -> dict:
+    """The settings as JSON values (paths as strings), the encoder's too."""
+    out = asdict(settings)
+    out["flow_options"] = {
+        k: str(v) if isinstance(v, os.PathLike) else v for k, v in settings.flow_options.items()
+    }
+    return out
 
 
 def _check_output(src: Path, dst: Path, overwrite: bool) -> None:

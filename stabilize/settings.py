@@ -45,6 +45,8 @@ class Settings:
     gyro_lpf: float | None = None  # Hz
     readout_ms: float | str | None = None  # rolling shutter: ms, 'auto', or the log's value
     gyro_drift: bool = False  # also fit a linear clock drift
+    gyro_timestamps: str | None = None  # frame times on the gyro clock (a file)
+    gyro_search: float = 1.0  # offset search range, ± s (a log on its own clock: all of it)
     lens: str | None = None  # a Gyroflow lens profile (OpenCV fisheye)
     device: str = "cpu"  # where frames are warped: cpu (OpenCV) or cuda (kornia, batched)
     size: tuple[int, int] | None = None  # output (H, W); default: the input's

@@ -24,6 +24,7 @@ RANK = {
     "settings": 2,
     "progress": 2,
     "video": 1,
+    "lazy": 0,
 }
 
 

@@ -11,19 +11,40 @@ from __future__ import annotations
 
 import sys
 
+import typer
+from typer.exceptions import TyperException
+
 from stabilize.cli import batch, compare, evaluate, rotations, run, synth
-from stabilize.cli.app import app
+from stabilize.cli.app import BAD_INPUT, app
 
 COMMANDS = ("run", "rotations", "synth", "evaluate", "compare", "batch")
 __all__ = ["COMMANDS", "app", "batch", "compare", "evaluate", "main", "rotations", "run", "synth"]
 
 
+TOP_LEVEL = ("--help", "-h", "--version")  # what the app itself answers
+
+
 def main() -> None:
-    """Console-script entry point: a first argument that is no command runs the main job."""
+    """Console-script entry point.
+
+    A line that names no command runs the main job, wherever its options stand
+    (``stabilize -q in.mp4 out.mp4``). A usage mistake is one ``error:`` line and exit
+    status 2, as every other failure; Ctrl-C ends with one line and status 130.
+    """
     args = sys.argv[1:]
-    if args and not args[0].startswith("-") and args[0] not in COMMANDS:
+    if args and args[0] not in COMMANDS and args[0] not in TOP_LEVEL:
         args = ["run", *args]
-    app(args=args, prog_name="stabilize")
+    try:
+        status = app(args=args, prog_name="stabilize", standalone_mode=False)
+    except TyperException as err:  # click's usage errors, in typer's own copy of click
+        message = err.format_message() if hasattr(err, "format_message") else str(err)
+        if message:  # (no arguments at all: the help was shown, and that is all)
+            typer.echo(f"error: {message}", err=True)
+        status = getattr(err, "exit_code", BAD_INPUT)
+    except KeyboardInterrupt:
+        typer.echo("error: interrupted; nothing was written under the output's name", err=True)
+        status = 130
+    sys.exit(status or 0)
 
 
 if __name__ == "__main__":

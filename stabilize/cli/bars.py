@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Callable, Iterator
+from typing import TypeVar
 
 from rich.console import Console
 from rich.progress import (
@@ -16,6 +17,10 @@ from rich.progress import (
     TimeElapsedColumn,
     TimeRemainingColumn,
 )
+
+from stabilize.progress import ProgressFactory
+
+T = TypeVar("T")
 
 
 @contextlib.contextmanager
@@ -44,7 +49,22 @@ def progress_bar(
             if speed:
                 progress.update(task, rate=f"{speed:.1f} {unit}/s")
 
-        yield advance
+        try:
+            yield advance
+        except BaseException:
+            progress.live.transient = True  # a failure leaves no half bar above its message
+            raise
+
+
+def with_bars(job: Callable[[ProgressFactory], T], *, quiet: bool = False) -> T:
+    """``job(bar)``, where ``bar(label, total)`` opens a progress bar for a stage; the
+    bars stay until the job is done, and are cleared when it fails."""
+    with contextlib.ExitStack() as stack:
+
+        def bar(label: str, total: int | None) -> Callable[[int], None]:
+            return stack.enter_context(progress_bar(label, total, quiet=quiet))
+
+        return job(bar)
 
 
 @contextlib.contextmanager

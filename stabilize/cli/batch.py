@@ -6,10 +6,12 @@ from pathlib import Path
 
 import typer
 
-from stabilize.cli.app import app, fail
+from stabilize.cli.app import announce_compiling, app, fail, run_or_fail
 from stabilize.cli.options import (
     ENCODING,
+    GYRO_SEARCH,
     NO_PREVIEW,
+    SIDECARS,
     CodecOption,
     CrfOption,
     CropOption,
@@ -20,6 +22,7 @@ from stabilize.cli.options import (
     GyroDriftOption,
     GyroFormatOption,
     GyroLpfOption,
+    GyroSearchOption,
     LensOption,
     LockOption,
     MaxZoomOption,
@@ -52,7 +55,15 @@ def batch(
     workers: int | None = typer.Option(None, min=1, help="Parallel files (default: per core)."),
     pattern: str = typer.Option("*", help="Which files, as a glob."),
     recursive: bool = typer.Option(False, help="Descend into subfolders."),
-    gyro: str | None = typer.Option(None, help="'auto': use a gyro log with the same base name."),
+    gyro: str | None = typer.Option(
+        None, help=f"'auto': use the gyro log beside each clip, of the same name ({SIDECARS})."
+    ),
+    output_format: str | None = typer.Option(
+        None,
+        "--format",
+        help="Write every clip as this container, e.g. .mkv (default: each input's).",
+    ),
+    force: bool = typer.Option(False, "--force", help="Redo every file, finished or not."),
     ray: str | None = typer.Option(
         None, help="Run on a Ray cluster: its address, or 'auto' (needs the 'cluster' extra)."
     ),
@@ -73,6 +84,7 @@ def batch(
     preview: PreviewOption = NO_PREVIEW,
     size: SizeOption = None,
     gyro_format: GyroFormatOption = None,
+    gyro_search: GyroSearchOption = GYRO_SEARCH,
     gyro_lpf: GyroLpfOption = DEFAULTS.gyro_lpf,
     gyro_drift: GyroDriftOption = DEFAULTS.gyro_drift,
     readout_ms: ReadoutOption = None,
@@ -81,7 +93,7 @@ def batch(
     """Stabilise every clip in a folder: resumable, one failure never stops the rest."""
     from rich.console import Console
 
-    from stabilize.batch import find_jobs, run_batch
+    from stabilize.batch import run_batch
     from stabilize.cli.bars import batch_progress
 
     if not in_dir.is_dir():
@@ -89,9 +101,8 @@ def batch(
     if gyro not in (None, "auto"):
         fail("--gyro in batch mode takes 'auto' (a sidecar log per clip)")
     settings = job_settings(ctx.params)
-    jobs = find_jobs(in_dir, out_dir, pattern, recursive, gyro_auto=gyro == "auto")
-    if not jobs:
-        fail(f"{in_dir}: no files match {pattern!r}")
+    jobs = _jobs(ctx.params, settings)
+    announce_compiling()
     console = Console(stderr=True)
     with batch_progress(len(jobs), quiet=quiet) as (file_done, frames_done):
 
@@ -101,12 +112,27 @@ def batch(
                 console.print(f"{row['status']:8s} {row['input']}  {row.get('error', '')}")
 
         try:
-            rows = run_batch(
-                jobs, out_dir, settings, workers, done, ray_address=ray, on_frames=frames_done
-            )
+            rows = run_batch(jobs, out_dir, settings, workers, done, ray, frames_done, force=force)
         except (RuntimeError, ConnectionError) as err:
             fail(str(err).splitlines()[0])
     _print_rows(rows, out_dir, quiet)
+
+
+def _jobs(params: dict, settings) -> list:
+    """The folder's jobs, after checking that ``--format``'s container takes the encoder."""
+    from stabilize.batch import find_jobs
+    from stabilize.video.preflight import check_encoder
+
+    fmt, pattern = params["output_format"], params["pattern"]
+    suffix = (fmt if fmt.startswith(".") else f".{fmt}") if fmt else None
+    if suffix:
+        run_or_fail(lambda: check_encoder(Path(f"check{suffix}"), settings.encoding, (64, 64)))
+    gyro_auto = params["gyro"] == "auto"
+    in_dir, out_dir = params["in_dir"], params["out_dir"]
+    jobs = find_jobs(in_dir, out_dir, pattern, params["recursive"], gyro_auto, suffix)
+    if not jobs:
+        fail(f"{in_dir}: no files match {pattern!r}")
+    return jobs
 
 
 def _print_rows(rows: list[dict], out_dir: Path, quiet: bool) -> None:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import contextlib
 import json
 from dataclasses import replace
 from pathlib import Path
@@ -11,13 +10,19 @@ import numpy as np
 import typer
 from numpy.typing import NDArray
 
-from stabilize.cli.app import app, fail
-from stabilize.cli.bars import progress_bar
+from stabilize.cli.app import announce_compiling, app, run_or_fail
+from stabilize.cli.bars import with_bars
 from stabilize.cli.options import (
+    GYRO_SEARCH,
     FlowOption,
     FocalOption,
     FovOption,
+    GyroAxesOption,
+    GyroDriftOption,
     GyroFormatOption,
+    GyroOffsetOption,
+    GyroSearchOption,
+    GyroTimestampsOption,
     JsonOption,
     LensOption,
     QuietOption,
@@ -36,9 +41,9 @@ from stabilize.video.probe import VideoInfo
         "Examples:\n\n"
         "  stabilize compare clip.mp4 --gyro gyro.csv --report cmp/\n\n"
         "  stabilize compare 'frames/RE_frame-%d.jpg' --start-number 99 --gyro gyro.txt "
-        "--timestamps framestamp.txt --focal 573.85 --json\n\n"
-        "  stabilize compare clip.mp4 --gyro log.gcsv --offset 0.042 --axes YXz\n\n"
-        "  stabilize compare clip.mp4 --gyro gyro.csv --calibrate-focal --drift"
+        "--gyro-timestamps framestamp.txt --focal 573.85 --json\n\n"
+        "  stabilize compare clip.mp4 --gyro log.gcsv --gyro-offset 0.042 --gyro-axes YXz\n\n"
+        "  stabilize compare clip.mp4 --gyro gyro.csv --calibrate-focal --gyro-drift"
     )
 )
 def compare(
@@ -46,23 +51,21 @@ def compare(
     video: str = typer.Argument(..., help="A video, or an image pattern like dir/img-%d.jpg."),
     gyro: Path = typer.Option(..., help="The gyro log."),
     gyro_format: GyroFormatOption = None,
-    timestamps: Path | None = typer.Option(
-        None, help="Frame times on the gyro clock (OpenCamera ns, or seconds per line)."
-    ),
+    gyro_timestamps: GyroTimestampsOption = None,
     start_number: int | None = typer.Option(None, help="First image number of a pattern."),
     fps: float | None = typer.Option(None, help="Frame rate of an image sequence."),
     fov: FovOption = DEFAULTS.fov,
     focal: FocalOption = DEFAULTS.focal,
     lens: LensOption = None,
-    offset: float | None = typer.Option(None, help="Gyro minus video clock, s (skip the search)."),
-    axes: str | None = typer.Option(None, help="IMU axis of camera x, y, z, e.g. YXz."),
-    search: float = typer.Option(1.0, min=0.0, help="Offset search range, ± seconds."),
+    gyro_offset: GyroOffsetOption = None,
+    gyro_axes: GyroAxesOption = None,
+    gyro_search: GyroSearchOption = GYRO_SEARCH,
     readout_ms: str = typer.Option(
         "auto",
         help="Rolling-shutter readout, ms (0: global shutter), or 'auto': the log's value, "
         "else estimated from bands of the frame.",
     ),
-    drift: bool = typer.Option(False, "--drift", help="Also fit a linear clock drift."),
+    gyro_drift: GyroDriftOption = DEFAULTS.gyro_drift,
     calibrate_focal: bool = typer.Option(
         False,
         "--calibrate-focal",
@@ -73,14 +76,16 @@ def compare(
     report: Path | None = typer.Option(None, help="Write pairs.csv, summary.json and plots here."),
     as_json: JsonOption = False,
     quiet: QuietOption = False,
+    # The spellings before run and compare shared one vocabulary, kept working:
+    timestamps: Path | None = typer.Option(None, "--timestamps", hidden=True),
+    offset: float | None = typer.Option(None, "--offset", hidden=True),
+    axes: str | None = typer.Option(None, "--axes", hidden=True),
+    search: float | None = typer.Option(None, "--search", min=0.0, hidden=True),
+    drift: bool = typer.Option(False, "--drift", hidden=True),
 ) -> None:
     """Compare the visual rotation estimate with a gyroscope log."""
-    with contextlib.ExitStack() as stack:
-
-        def bar(label: str, total: int | None):
-            return stack.enter_context(progress_bar(label, total, quiet=quiet))
-
-        result = _comparison(ctx.params, bar)
+    params = _canonical(ctx.params)
+    result = run_or_fail(lambda: with_bars(lambda bar: _comparison(params, bar), quiet=quiet))
     summary = result.summary() | {"focal_calibrated": calibrate_focal}
     if report is not None:
         from stabilize.evaluate.compare import write_comparison
@@ -94,49 +99,66 @@ def compare(
     typer.echo(_describe(summary))
 
 
+ALIASES = {  # an old spelling → the option it stands for
+    "timestamps": "gyro_timestamps",
+    "offset": "gyro_offset",
+    "axes": "gyro_axes",
+    "search": "gyro_search",
+    "drift": "gyro_drift",
+}
+
+
+def _canonical(params: dict) -> dict:
+    """The options under their names, an old spelling standing in where it was used."""
+    out = {k: v for k, v in params.items() if k not in ALIASES}
+    for old, name in ALIASES.items():
+        if params[old] not in (None, False):
+            out[name] = params[old]
+    return out
+
+
 def _comparison(params: dict, bar: ProgressFactory):
-    """The comparison the parsed options ``params`` ask for; any failure is one line."""
+    """The comparison the parsed options ``params`` ask for."""
     from stabilize.evaluate.compare import compare_video
-    from stabilize.gyro import GyroError, read_gyro
+    from stabilize.gyro import read_gyro
     from stabilize.gyro.path import readout_seconds
     from stabilize.gyro.sync import SyncOptions
-    from stabilize.video import VideoError
     from stabilize.warp.lens import read_lens_profile
 
     flow_name, weights, fov, focal = (
         params[k] for k in ("flow_name", "raft_weights", "fov", "focal")
     )
     settings = flow_settings(flow_name, weights, "cpu", fov=fov, focal=focal, max_deg=15.0)
-    R_cam_imu = axes_matrix(params["axes"])
+    R_cam_imu = axes_matrix(params["gyro_axes"])
     calibrate = params["calibrate_focal"]
-    try:
-        log = read_gyro(params["gyro"], params["gyro_format"])
-        info, times = _video_and_times(
-            params["video"], params["start_number"], params["fps"], params["timestamps"]
-        )
-        camera = read_lens_profile(params["lens"], info.size) if params["lens"] else None
-        if camera is not None and calibrate:
-            fail("--calibrate-focal fits a pinhole focal length; --lens brings its own")
-        if camera is not None:
-            settings = replace(settings, focal=float(camera.K[0, 0]))
-        # Unlike the stabiliser, compare estimates (None) a readout the log does not give.
-        parsed = readout(params["readout_ms"], params["gyro"])
-        given = log.readout_s or (camera and camera.readout_s)
-        known = given if parsed == "auto" else readout_seconds(parsed, None)
-        options = SyncOptions(params["offset"], R_cam_imu, known, params["drift"], params["search"])
-        return compare_video(
-            params["video"],
-            info,
-            log,
-            settings,
-            times,
-            options,
-            lens=camera,
-            calibrate_focal=calibrate,
-            progress=bar,
-        )
-    except (VideoError, GyroError, ValueError) as err:
-        fail(str(err))
+    log = read_gyro(params["gyro"], params["gyro_format"])
+    info, times = _video_and_times(
+        params["video"], params["start_number"], params["fps"], params["gyro_timestamps"]
+    )
+    camera = read_lens_profile(params["lens"], info.size) if params["lens"] else None
+    if camera is not None and calibrate:
+        raise ValueError("--calibrate-focal fits a pinhole focal length; --lens brings its own")
+    if camera is not None:
+        settings = replace(settings, focal=float(camera.K[0, 0]))
+    # Unlike the stabiliser, compare estimates (None) a readout the log does not give.
+    parsed = readout(params["readout_ms"], params["gyro"])
+    given = log.readout_s or (camera and camera.readout_s)
+    known = given if parsed == "auto" else readout_seconds(parsed, None)
+    options = SyncOptions(
+        params["gyro_offset"], R_cam_imu, known, params["gyro_drift"], params["gyro_search"]
+    )
+    announce_compiling()
+    return compare_video(
+        params["video"],
+        info,
+        log,
+        settings,
+        times,
+        options,
+        lens=camera,
+        calibrate_focal=calibrate,
+        progress=bar,
+    )
 
 
 def _video_and_times(

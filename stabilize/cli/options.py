@@ -11,44 +11,108 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import typer
 
+import flow
 from stabilize.cli.app import fail
+from stabilize.gyro.readers import FORMATS, GYRO_SIDECARS
+from stabilize.path.smoothing import METHODS
+from stabilize.path.zoom import CROP_MODES
 from stabilize.settings import Settings
 from stabilize.video.encode import Encoding
 
 FlowOption = Annotated[
-    str, typer.Option("--flow", help="Optical flow: dis (fast, CPU), raft or raft-large.")
+    Literal[tuple(flow.BACKENDS)],
+    typer.Option("--flow", help="Optical flow: dis (fast, CPU), raft or raft-large."),
 ]
 RaftWeightsOption = Annotated[Path | None, typer.Option(help="RAFT checkpoint (.pth).")]
-DeviceOption = Annotated[str, typer.Option(help="cpu or cuda: RAFT flow and the frame warps.")]
+DeviceOption = Annotated[
+    Literal["cpu", "cuda"], typer.Option(help="Where RAFT flow and the frame warps run.")
+]
 FovOption = Annotated[
     float | None,
-    typer.Option(help="Horizontal field of view, deg (default 69: a phone's main camera)."),
+    typer.Option(
+        min=1.0,
+        max=179.0,
+        help="Horizontal field of view, deg (default 69: a phone's main camera).",
+    ),
 ]
 FocalOption = Annotated[
-    float | None, typer.Option(help="Focal length in pixels (overrides --fov).")
+    float | None,
+    typer.Option(min=1.0, help="Focal length in pixels (overrides --fov)."),
 ]
 LensOption = Annotated[
     Path | None,
     typer.Option(help="Gyroflow lens profile (.json, OpenCV fisheye): overrides --fov/--focal."),
 ]
 SmoothOption = Annotated[float, typer.Option(min=0.01, help="Smoothing time constant, s.")]
-MethodOption = Annotated[str, typer.Option(help="adaptive (follows pans) or gaussian.")]
-LockOption = Annotated[bool, typer.Option(help="Hold one orientation, like a tripod.")]
-MaxZoomOption = Annotated[float, typer.Option(min=1.0, help="Never zoom in more than this.")]
-CropOption = Annotated[str, typer.Option(help="auto (one zoom), dynamic (smoothly varying), none.")]
-CodecOption = Annotated[str, typer.Option(help="libx264 or libx265.")]
-CrfOption = Annotated[int, typer.Option(min=0, max=51, help="Encoder quality (lower is better).")]
-PresetOption = Annotated[str, typer.Option(help="Encoder speed preset.")]
-PreviewOption = Annotated[
-    str, typer.Option(help="side-by-side: the original and the stabilised clip next to each other.")
+MethodOption = Annotated[
+    Literal[tuple(METHODS)],
+    typer.Option(help="adaptive (follows pans), gaussian, or lock (a tripod: one orientation)."),
 ]
-SizeOption = Annotated[str | None, typer.Option(help="Output WIDTHxHEIGHT (default: the input's).")]
-GyroFormatOption = Annotated[str | None, typer.Option(help="Override the detected log format.")]
+LockOption = Annotated[bool, typer.Option(help="Hold one orientation, like a tripod.")]
+MaxZoomOption = Annotated[
+    float, typer.Option(min=1.0, max=4.0, help="Never zoom in more than this.")
+]
+CropOption = Annotated[
+    Literal[tuple(CROP_MODES)],
+    typer.Option(help="auto (one zoom), dynamic (smoothly varying), none."),
+]
+CodecOption = Annotated[
+    str | None,
+    typer.Option(
+        help="Video encoder (any FFmpeg has): default libx264, or libvpx-vp9 for .webm; "
+        "libx265 for HEVC, libsvtav1 for AV1."
+    ),
+]
+CrfOption = Annotated[
+    int | None,
+    typer.Option(
+        min=0, max=63, help="Encoder quality, lower is better (default: 18 for x264, 31 VP9)."
+    ),
+]
+PresetOption = Annotated[str, typer.Option(help="Encoder speed preset (x264's names).")]
+PreviewOption = Annotated[
+    Literal["none", "side-by-side"],
+    typer.Option(help="side-by-side: the original and the stabilised clip next to each other."),
+]
+SizeOption = Annotated[
+    str | None, typer.Option(help="Output WIDTHxHEIGHT, both even (default: the input's).")
+]
+FORMAT_HELP = ", ".join(FORMATS)
+GyroFormatOption = Annotated[
+    Literal[FORMATS] | None,
+    typer.Option(help=f"The log's format, if not detected: {FORMAT_HELP}."),
+]
+GyroOffsetOption = Annotated[
+    float | None, typer.Option("--gyro-offset", help="Gyro minus video clock, s (no search).")
+]
+GyroAxesOption = Annotated[
+    str | None,
+    typer.Option(
+        "--gyro-axes",
+        help="The IMU axis of camera x, y and z as three letters, e.g. YXz: camera x is "
+        "IMU +Y, y is +X, z is -Z (lower case: the negative axis). Default: found.",
+    ),
+]
+GyroSearchOption = Annotated[
+    float,
+    typer.Option(
+        "--gyro-search",
+        min=0.0,
+        help="Offset search range, ± s; a log on its own clock is searched whole.",
+    ),
+]
+GyroTimestampsOption = Annotated[
+    Path | None,
+    typer.Option(
+        "--gyro-timestamps",
+        help="Frame times on the gyro clock (OpenCamera ns, or seconds per line).",
+    ),
+]
 GyroLpfOption = Annotated[float | None, typer.Option(help="Low-pass the gyro at this many Hz.")]
 GyroDriftOption = Annotated[bool, typer.Option("--gyro-drift", help="Also fit a clock drift.")]
 ReadoutOption = Annotated[
@@ -61,18 +125,18 @@ ReadoutOption = Annotated[
 OverwriteOption = Annotated[bool, typer.Option(help="Replace the output if it exists.")]
 QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")]
 JsonOption = Annotated[bool, typer.Option("--json", help="Print the summary as JSON on stdout.")]
+SIDECARS = ", ".join(GYRO_SIDECARS)
 
 # The defaults of the options above that are not Settings fields by the same name.
 ENCODING = Encoding()
 NO_PREVIEW = "none"
+GYRO_SEARCH = 1.0
 
 
 def job_settings(params: Mapping[str, Any]) -> Settings:
     """The pipeline's Settings from the options ``run`` and ``batch`` share: a command's
     ``ctx.params``. Options the command does not have keep their defaults."""
     preview = params.get("preview", NO_PREVIEW)
-    if preview not in (NO_PREVIEW, "side-by-side"):
-        fail(f"--preview must be none or side-by-side, got {preview!r}")
     gyro = params.get("gyro")
     axes = params.get("gyro_axes")
     lens = params.get("lens")
@@ -97,14 +161,14 @@ def job_settings(params: Mapping[str, Any]) -> Settings:
         gyro_format=params["gyro_format"],
         gyro_offset=params.get("gyro_offset"),
         gyro_axes=None if axes is None else tuple(map(tuple, axes_matrix(axes))),
+        gyro_timestamps=str(stamps) if (stamps := params.get("gyro_timestamps")) else None,
+        gyro_search=params.get("gyro_search", GYRO_SEARCH),
     )
 
 
 def flow_settings(flow_name: str, raft_weights: Path | None, device: str, **options) -> Settings:
     """Settings with the flow backend and device checked; options are Settings fields
     (fov, smooth, crop, ...)."""
-    if device not in ("cpu", "cuda"):
-        fail(f"--device must be cpu or cuda, got {device!r}")
     if device == "cuda":
         import torch
 
@@ -126,6 +190,8 @@ def output_size(text: str | None) -> tuple[int, int] | None:
         fail(f"--size must be WIDTHxHEIGHT, e.g. 1280x720, got {text!r}")
     if w < 16 or h < 16 or w > 16384 or h > 16384:
         fail(f"--size {text}: each side must be 16..16384 pixels")
+    if w % 2 or h % 2:
+        fail(f"--size {text}: both sides must be even (4:2:0 video), e.g. {w - w % 2}x{h - h % 2}")
     return h, w
 
 
@@ -142,7 +208,7 @@ def readout(value: str | None, gyro: object) -> float | str | None:
 
 
 def axes_matrix(code: str | None) -> np.ndarray | None:
-    """--axes 'YXz' → R_cam_imu (:mod:`stabilize.gyro.axes`): camera x, y, z are IMU Y,
+    """--gyro-axes 'YXz' → R_cam_imu (:mod:`stabilize.gyro.axes`): camera x, y, z are IMU Y,
     X and -Z (lower case: negative)."""
     if code is None:
         return None
@@ -150,6 +216,6 @@ def axes_matrix(code: str | None) -> np.ndarray | None:
     from stabilize.gyro.log import GyroError
 
     try:
-        return parse(code, what="--axes")
+        return parse(code, what="--gyro-axes")
     except GyroError as err:
         fail(str(err))

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from stabilize.cli.app import app, fail
+from stabilize.cli.app import announce_compiling, app, fail, run_or_fail
 from stabilize.cli.options import (
     DeviceOption,
     FlowOption,
@@ -17,6 +17,7 @@ from stabilize.cli.options import (
     RaftWeightsOption,
     flow_settings,
 )
+from stabilize.settings import DEFAULTS
 
 
 @app.command(
@@ -35,35 +36,42 @@ def rotations(
     gcsv: Path | None = typer.Option(
         None, help="Also (or only) write the rates as a Gyroflow .gcsv, for clips with no gyro."
     ),
-    flow_name: FlowOption = "dis",
+    flow_name: FlowOption = DEFAULTS.flow,
     raft_weights: RaftWeightsOption = None,
-    device: DeviceOption = "cpu",
-    fov: FovOption = None,
-    focal: FocalOption = None,
+    device: DeviceOption = DEFAULTS.device,
+    fov: FovOption = DEFAULTS.fov,
+    focal: FocalOption = DEFAULTS.focal,
     overwrite: OverwriteOption = False,
     quiet: QuietOption = False,
 ) -> None:
     """Estimate only: the camera rotation R_t of every frame pair (radians)."""
     from rotation import so3
-    from stabilize.cli.bars import progress_bar
+    from stabilize.cli.bars import with_bars
     from stabilize.motion.estimate import estimate_rotations
     from stabilize.motion.files import write_rotations
-    from stabilize.video import VideoError, atomic_output, probe
+    from stabilize.video import atomic_output, probe
+    from stabilize.video.preflight import check_writable
 
     if output is None and gcsv is None:
         fail("give -o rotations.csv and/or --gcsv out.gcsv")
+    targets = [t for t in (output, gcsv) if t is not None]
+    for target in targets:  # before any work, not after it
+        if target.exists() and not overwrite:
+            fail(f"{target} exists (use --overwrite to replace it)")
+        run_or_fail(lambda target=target: check_writable(target))
     settings = flow_settings(flow_name, raft_weights, device, fov=fov, focal=focal)
-    try:
-        info = probe(input_path)
-        with progress_bar("estimating", None, quiet=quiet) as advance:
-            track = estimate_rotations(input_path, info, settings, advance)
-        if output is not None:
-            with atomic_output(output, overwrite=overwrite) as tmp:
-                write_rotations(tmp, track.times[:-1], so3.log_so3(track.rotations), track.support)
-        if gcsv is not None:
-            from stabilize.gyro.export import write_gcsv
+    info = run_or_fail(lambda: probe(input_path))
 
-            with atomic_output(gcsv, overwrite=overwrite) as tmp:
-                write_gcsv(tmp, track.times, track.rotations)
-    except (VideoError, ValueError, FileExistsError, RuntimeError) as err:
-        fail(str(err))
+    def estimate(bar):
+        return estimate_rotations(input_path, info, settings, bar("estimating", None))
+
+    announce_compiling()
+    track = run_or_fail(lambda: with_bars(estimate, quiet=quiet))
+    if output is not None:
+        with atomic_output(output, overwrite=overwrite) as tmp:
+            write_rotations(tmp, track.times[:-1], so3.log_so3(track.rotations), track.support)
+    if gcsv is not None:
+        from stabilize.gyro.export import write_gcsv
+
+        with atomic_output(gcsv, overwrite=overwrite) as tmp:
+            write_gcsv(tmp, track.times, track.rotations)

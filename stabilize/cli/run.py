@@ -2,15 +2,15 @@
 
 from __future__ import annotations
 
-import contextlib
 import json
 from pathlib import Path
 
 import typer
 
-from stabilize.cli.app import app, fail
+from stabilize.cli.app import app, check_report_folder, notice, run_or_fail
 from stabilize.cli.options import (
     ENCODING,
+    GYRO_SEARCH,
     NO_PREVIEW,
     CodecOption,
     CrfOption,
@@ -19,9 +19,13 @@ from stabilize.cli.options import (
     FlowOption,
     FocalOption,
     FovOption,
+    GyroAxesOption,
     GyroDriftOption,
     GyroFormatOption,
     GyroLpfOption,
+    GyroOffsetOption,
+    GyroSearchOption,
+    GyroTimestampsOption,
     JsonOption,
     LensOption,
     LockOption,
@@ -79,8 +83,10 @@ def run(
         None, help="Stabilise from this gyro log (synchronised to the video) instead."
     ),
     gyro_format: GyroFormatOption = None,
-    gyro_offset: float | None = typer.Option(None, help="Gyro minus video clock, s."),
-    gyro_axes: str | None = typer.Option(None, help="IMU axis of camera x, y, z, e.g. YXz."),
+    gyro_offset: GyroOffsetOption = None,
+    gyro_axes: GyroAxesOption = None,
+    gyro_timestamps: GyroTimestampsOption = None,
+    gyro_search: GyroSearchOption = GYRO_SEARCH,
     gyro_lpf: GyroLpfOption = DEFAULTS.gyro_lpf,
     gyro_drift: GyroDriftOption = DEFAULTS.gyro_drift,
     readout_ms: ReadoutOption = None,
@@ -89,26 +95,23 @@ def run(
     as_json: JsonOption = False,
 ) -> None:
     """Stabilise a video: estimate each frame's rotation, smooth the path, warp, encode."""
-    from stabilize.cli.bars import progress_bar
+    from stabilize.cli.bars import with_bars
     from stabilize.pipeline import stabilize_video
-    from stabilize.video import VideoError
 
     settings = job_settings(ctx.params)
-    with contextlib.ExitStack() as stack:
+    if report is not None:
+        check_report_folder(report)
 
-        def bar(label: str, total: int | None):
-            return stack.enter_context(progress_bar(label, total, quiet=quiet))
+    def job(bar):
+        return stabilize_video(
+            input_path, output_path, settings, overwrite=overwrite, progress=bar, notify=notice
+        )
 
-        try:
-            summary, planned = stabilize_video(
-                input_path, output_path, settings, overwrite=overwrite, progress=bar
-            )
-        except (VideoError, ValueError, FileExistsError, FileNotFoundError, RuntimeError) as err:
-            fail(str(err))
+    summary, planned = run_or_fail(lambda: with_bars(job, quiet=quiet))
     if report is not None:
         from stabilize.evaluate.report import write_report
 
-        write_report(report, planned, summary)
+        run_or_fail(lambda: write_report(report, planned, summary))
     if as_json:
         typer.echo(json.dumps(summary, indent=2))
     elif not quiet:

@@ -4,10 +4,13 @@ estimated."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.gyro.readers import read_gyro
+from stabilize.gyro.log import GyroLog
+from stabilize.gyro.readers import read_gyro, sensor_frame_times
 from stabilize.gyro.rolling_shutter import frame_rotations, row_turns
 from stabilize.gyro.source import gyro_rotations, lowpass
 from stabilize.gyro.sync import SyncOptions
@@ -17,17 +20,30 @@ from stabilize.warp.lens import Lens
 from stabilize.warp.rolling import RollingShutter
 
 
-def gyro_path(
-    settings: Settings, track: VisualTrack, height: int, lens: Lens | None = None
-) -> tuple[NDArray, RollingShutter | None, dict]:
-    """(R_t, the rolling-shutter turns or None, a summary) from the gyro log named in
-    ``settings``, synchronised against the visual ``track``."""
+def load_gyro(settings: Settings, frames: int) -> GyroLog:
+    """The log ``settings`` name, read, checked and filtered before any work is done;
+    with ``gyro_timestamps``, that file is checked to hold the clip's ``frames`` times."""
     log = read_gyro(settings.gyro, settings.gyro_format)
-    if settings.gyro_lpf:
-        log = lowpass(log, settings.gyro_lpf)
+    if settings.gyro_timestamps:
+        sensor_frame_times(settings.gyro_timestamps, 0, frames)
+    readout_seconds(settings.readout_ms, None)
+    return lowpass(log, settings.gyro_lpf) if settings.gyro_lpf else log
+
+
+def gyro_path(
+    settings: Settings, log: GyroLog, track: VisualTrack, height: int, lens: Lens | None = None
+) -> tuple[NDArray, RollingShutter | None, dict]:
+    """(R_t, the rolling-shutter turns or None, a summary) from a gyro ``log``
+    (:func:`load_gyro`), synchronised against the visual ``track``. With
+    ``gyro_timestamps`` the frames are dated on the gyro's clock by that file."""
+    if settings.gyro_timestamps:
+        stamps = sensor_frame_times(settings.gyro_timestamps, 0, len(track.times))
+        track = replace(track, times=stamps)
     axes = None if settings.gyro_axes is None else np.array(settings.gyro_axes, dtype=float)
     readout = readout_seconds(settings.readout_ms, log.readout_s or (lens and lens.readout_s))
-    options = SyncOptions(settings.gyro_offset, axes, readout, settings.gyro_drift)
+    options = SyncOptions(
+        settings.gyro_offset, axes, readout, settings.gyro_drift, settings.gyro_search
+    )
     att, sync = gyro_rotations(log, track, options)
     clock = sync.clock(track.times)
     R = frame_rotations(att, clock, sync.offset, sync.readout)
@@ -43,6 +59,7 @@ def gyro_path(
             "rate_hz": log.rate_hz,
             "readout_ms": 1000.0 * sync.readout,
             "readout_estimated": sync.readout_estimated,
+            "searched_whole_log": sync.searched_whole_log,
         },
     )
 

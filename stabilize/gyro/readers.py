@@ -22,7 +22,9 @@ import numpy as np
 from stabilize.gyro.axes import axes_matrix
 from stabilize.gyro.log import GyroError, GyroLog
 
+GYRO_SIDECARS = (".gcsv", ".csv", ".txt")  # a log beside clip.mp4 (batch --gyro auto)
 VIDEO_SUFFIXES = {".mp4", ".mov", ".insv", ".360", ".mxf", ".mkv", ".braw", ".lrv", ".m4v"}
+NS_PER_FRAME_AT_LEAST = 1000.0  # a median frame step above this is in nanoseconds
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 RATE_UNITS = {"rad/s": 1.0, "deg/s": np.pi / 180.0}
 
@@ -80,7 +82,8 @@ def sensor_frame_times(path: str | Path, first: int, count: int) -> np.ndarray:
     """``count`` frame times (s, on the sensor's clock) from line ``first`` (0-based) of a
     timestamps file: seconds per line (phone-cc9), or integer nanoseconds (OpenCamera)."""
     stamps = read_frame_timestamps_s(path)
-    if stamps[0] > 1e12:  # integer nanoseconds (OpenCamera), not seconds
+    # A frame interval is under a second; in nanoseconds (OpenCamera) it is millions.
+    if len(stamps) > 1 and np.median(np.diff(stamps)) > NS_PER_FRAME_AT_LEAST:
         stamps = stamps * 1e-9
     times = stamps[first : first + count]
     if len(times) < count:

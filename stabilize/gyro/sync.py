@@ -70,6 +70,7 @@ class Sync:
     readout_estimated: bool = False
     drift: float = 0.0  # gyro clock rate minus video clock rate (1e-6 = 1 ppm)
     origin: float = 0.0  # video time at which ``offset`` holds exactly
+    searched_whole_log: bool = False  # the log's clock lay outside the search range
 
     def lag(self, track: VisualTrack) -> NDArray[np.float64]:
         """Per pair, when its rotation was seen after the first row: readout × mean height."""
@@ -131,20 +132,43 @@ class IntervalRates:
 
 def coarse_offset(
     gyro: IntervalRates, times: NDArray, w_vis: NDArray, search: tuple[float, float]
+) -> tuple[float, float, bool]:
+    """(offset, correlation, whole) maximising the correlation of angular speeds on a
+    1 ms grid over the ``search`` range.
+
+    A log on a clock of its own (an Android boot clock: its first sample at 123456 s)
+    overlaps the video at no offset in that range; then every offset at which the log
+    covers the video is searched (``whole`` True), coarsely at a quarter of a frame
+    interval, then to 1 ms around the best.
+    """
+    best = _best_offset(gyro, times, w_vis, np.arange(search[0], search[1] + 5e-4, 1e-3))
+    if np.isfinite(best[1]):
+        return (*best, False)
+    lo, hi = gyro.log.span
+    first, last = float(times[0]), float(times[-1])
+    if hi - lo >= MIN_COVERAGE * (last - first):
+        step = 0.25 * float(np.median(np.diff(times)))
+        coarse = _best_offset(gyro, times, w_vis, np.arange(lo - first, hi - last + step, step))
+        if np.isfinite(coarse[1]):
+            fine = np.arange(coarse[0] - step, coarse[0] + step + 5e-4, 1e-3)
+            return (*_best_offset(gyro, times, w_vis, fine), True)
+    raise GyroError(
+        f"{gyro.log.source}: the gyro log, {lo:.2f}–{hi:.2f} s on its clock "
+        f"({hi - lo:.2f} s), does not cover the video, {first:.2f}–{last:.2f} s "
+        f"({last - first:.2f} s), at any offset"
+    )
+
+
+def _best_offset(
+    gyro: IntervalRates, times: NDArray, w_vis: NDArray, offsets: NDArray
 ) -> tuple[float, float]:
-    """(offset, correlation) maximising the correlation of angular speeds, 1 ms grid."""
+    """(offset, correlation) of the best-correlated offset at which the log covers."""
     best = (0.0, -np.inf)
-    for delta in np.arange(search[0], search[1] + 5e-4, 1e-3):
+    for delta in offsets:
         if gyro.covers(times, delta):
             r = speed_correlation(gyro, times, w_vis, delta)
             if np.isfinite(r) and r > best[1]:
                 best = (float(delta), r)
-    if not np.isfinite(best[1]):
-        lo, hi = gyro.log.span
-        raise GyroError(
-            f"{gyro.log.source}: the gyro log ({hi - lo:.2f} s) does not cover the video "
-            f"({times[-1] - times[0]:.2f} s) at any offset in {search[0]:+.2f}…{search[1]:+.2f} s"
-        )
     return best
 
 
@@ -317,12 +341,15 @@ def synchronise(
     times = track.times
     w_vis = visual_rates(times, track.rotations)
     if offset is None:
-        delta, corr = coarse_offset(gyro, times, w_vis, search)
+        delta, corr, whole = coarse_offset(gyro, times, w_vis, search)
     else:
-        delta = float(offset)
+        delta, whole = float(offset), False
         if not gyro.covers(times, delta):
+            lo, hi = log.span
             raise GyroError(
-                f"{log.source}: the gyro log does not cover the video at offset {delta:+.3f} s"
+                f"{log.source}: the gyro log covers {lo:.2f}–{hi:.2f} s on its clock; at "
+                f"offset {delta:+.3f} s the video needs {times[0] + delta:.2f}–"
+                f"{times[-1] + delta:.2f} s"
             )
         corr = speed_correlation(gyro, times, w_vis, delta)
     R, bias = fit_axes(w_vis, gyro(times, delta), R_cam_imu)
@@ -355,4 +382,4 @@ def synchronise(
         delta, R, bias = refine_offset_and_axes(
             gyro, drifted(times, drift, times[0]), w_vis, delta, lag, fit, R_cam_imu, R, bias
         )
-    return Sync(delta, R, bias, corr, readout, estimated, drift, float(times[0]))
+    return Sync(delta, R, bias, corr, readout, estimated, drift, float(times[0]), whole)

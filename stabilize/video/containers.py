@@ -12,7 +12,7 @@ refuses one that FFmpeg cannot write.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 # Text subtitle codecs (FFmpeg's names): these convert into one another.
@@ -48,32 +48,20 @@ class Container:
         return self.subtitle_encoder if codec in TEXT_SUBTITLES else None
 
 
+MP4 = Container(
+    "mp4",
+    audio=QUICKTIME_AUDIO,
+    subtitles=frozenset({"mov_text"}),
+    subtitle_encoder="mov_text",
+    options=QUICKTIME,
+    hevc_tag="hvc1",
+)
+
 # The registry: an output suffix → its container. Adding one is a line here.
 CONTAINERS: dict[str, Container] = {
-    ".mp4": Container(
-        "mp4",
-        audio=QUICKTIME_AUDIO,
-        subtitles=frozenset({"mov_text"}),
-        subtitle_encoder="mov_text",
-        options=QUICKTIME,
-        hevc_tag="hvc1",
-    ),
-    ".m4v": Container(
-        "mp4",
-        audio=QUICKTIME_AUDIO,
-        subtitles=frozenset({"mov_text"}),
-        subtitle_encoder="mov_text",
-        options=QUICKTIME,
-        hevc_tag="hvc1",
-    ),
-    ".mov": Container(
-        "mov",
-        audio=QUICKTIME_AUDIO | {"pcm_s16le", "pcm_s24le"},
-        subtitles=frozenset({"mov_text"}),
-        subtitle_encoder="mov_text",
-        options=QUICKTIME,
-        hevc_tag="hvc1",
-    ),
+    ".mp4": MP4,
+    ".m4v": MP4,
+    ".mov": replace(MP4, muxer="mov", audio=QUICKTIME_AUDIO | {"pcm_s16le", "pcm_s24le"}),
     ".mkv": Container(
         "matroska",
         subtitles=frozenset(

@@ -28,6 +28,7 @@ class Stream:
     language: str = ""
     start: float | None = None  # s, where FFmpeg lists one apart from the file's
     tag: str = ""  # the container's codec tag, e.g. 'avc1', 'text'
+    title: str = ""  # its title ('name' in MP4, which FFmpeg writes back under another key)
 
 
 @dataclass(frozen=True)
@@ -78,6 +79,8 @@ _ROTATION = re.compile(r"rotation of (-?\d+(?:\.\d+)?) degrees|rotate\s*:\s*(-?\
 
 def _stream(match: re.Match, text: str) -> Stream:
     line = text[match.start() : text.find("\n", match.start())]
+    block = text[match.end() :].split("\n  Stream #", 1)[0]  # its Metadata: lines
+    title = re.search(r"^\s+(?:title|name)\s*: (.*)$", block, re.M)
     start = re.search(r", start (-?\d+(?:\.\d+)?)", line)
     tag = re.search(r"\((\w+) / 0x[0-9A-Fa-f]+\)", line)
     return Stream(
@@ -87,6 +90,7 @@ def _stream(match: re.Match, text: str) -> Stream:
         match.group(2) or "",
         float(start.group(1)) if start else None,
         tag.group(1) if tag else "",
+        title.group(1).strip() if title else "",
     )
 
 

@@ -53,8 +53,11 @@ def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0
         kept.append(stream.index)
     # One mapping per stream: any explicit one turns FFmpeg's per-stream default off.
     args += ["-map_metadata", "1", "-map_metadata:s:0", f"1:s:{_first_video(info)}"]
+    titles = {s.index: s.title for s in info.streams}
     for out, index in enumerate(kept, start=1):
         args += [f"-map_metadata:s:{out}", f"1:s:{index}"]
+        if titles[index]:
+            args += [f"-metadata:s:{out}", f"title={titles[index]}"]
     args += ["-map_chapters", "1" if container.chapters else "-1"]
     return Mux((("-i", str(info.path)),), tuple(args), tuple(notices), video_delay)
 

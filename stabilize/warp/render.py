@@ -45,8 +45,8 @@ def render(
     container = container_for(out)
     written = 0
     fps = info.fps or 30.0
-    h, w = settings.size or info.size
-    size = (h, 2 * w) if settings.preview else (h, w)
+    h, w = frame_size(info, settings)
+    size = encoded_size(info, settings)
     variable = is_variable_rate(planned.times)
     encoding = replace(settings.encoding, b_frames=False) if variable else settings.encoding
     target = out.with_name(f"{out.stem}.cfr{out.suffix}") if variable else out
@@ -69,6 +69,8 @@ def render(
                 ):
                     if settings.size:
                         frame, warped = resize(frame, (h, w)), resize(warped, (h, w))
+                    elif (h, w) != info.size:  # odd sides: one row or column off the edge
+                        frame, warped = frame[:h, :w], warped[:h, :w]
                     writer.write(side_by_side(frame, warped) if settings.preview else warped)
                     written += 1
                     progress(1)
@@ -78,6 +80,20 @@ def render(
         if variable:
             target.unlink(missing_ok=True)
     return written
+
+
+def frame_size(info: VideoInfo, settings: Settings) -> tuple[int, int]:
+    """(H, W) of each stabilised frame: ``--size``, else the input's with odd sides
+    rounded down (4:2:0 video needs even sides; the last row or column is cropped, the
+    smallest loss, and at the frame's edge, which the zoom crops anyway)."""
+    h, w = settings.size or info.size
+    return h - h % 2, w - w % 2
+
+
+def encoded_size(info: VideoInfo, settings: Settings) -> tuple[int, int]:
+    """(H, W) of the encoded frames: the stabilised frame, twice as wide in a preview."""
+    h, w = frame_size(info, settings)
+    return (h, 2 * w) if settings.preview else (h, w)
 
 
 def batches(items: Iterable, n: int) -> Iterator[list]:

@@ -66,6 +66,32 @@ def test_a_changed_input_is_done_again(folder, tmp_path):
     assert rows[0]["status"] == "done"
 
 
+def test_changed_settings_or_force_redo_a_file_and_format_converts(folder, tmp_path):
+    out = tmp_path / "out"
+    base = ["batch", str(folder), str(out), "--pattern", "a.mp4", "-q"]
+
+    def status(*extra: str) -> str:
+        result = CliRunner().invoke(app, [*base, *extra])
+        assert result.exit_code == 0, result.output
+        rows = json.loads((out / "manifest.json").read_text())
+        return next(r["status"] for r in rows if r["input"] == "a.mp4")
+
+    assert status() == "done"
+    assert status() == "skipped"  # the same settings: resumed
+    assert status("--smooth", "1.0") == "done"  # other settings: done again
+    assert status("--smooth", "1.0") == "skipped"
+    assert status("--smooth", "1.0", "--force") == "done"
+    assert status("--smooth", "1.0", "--format", "mkv") == "done"
+    assert (out / "a.mkv").is_file() and probe_muxer(out / "a.mkv") == "matroska"
+
+
+def probe_muxer(path: Path) -> str:
+    import av
+
+    with av.open(str(path)) as c:
+        return c.format.name.split(",")[0]
+
+
 def test_gyro_sidecars_are_found_and_not_taken_for_clips(folder, tmp_path):
     (folder / "a.gcsv").write_text("GYROFLOW IMU LOG\n")
     jobs = {j.input: j for j in find_jobs(folder, tmp_path / "out", gyro_auto=True)}

@@ -151,3 +151,14 @@ def test_the_public_api_names_the_job_and_its_stages():
         assert getattr(stabilize, name).__doc__, name
     with pytest.raises(AttributeError):
         stabilize.no_such_name  # noqa: B018
+
+
+def test_the_summary_serialises_every_setting():
+    import json
+    from pathlib import Path
+
+    from stabilize.pipeline import settings_summary
+
+    settings = Settings(flow="raft", flow_options={"weights": Path("w.pth"), "device": "cpu"})
+    text = json.dumps(settings_summary(settings))
+    assert '"weights": "w.pth"' in text and '"codec": null' in text

@@ -19,7 +19,7 @@ def test_batch_takes_every_option_of_the_single_file_command():
     commands = typer.main.get_command(app).commands
     names = {name: {p.name for p in commands[name].params} for name in ("run", "batch")}
     per_file = {"input_path", "output_path", "report", "overwrite", "as_json"}
-    per_clip_gyro = {"gyro_offset", "gyro_axes"}  # each clip's log has its own
+    per_clip_gyro = {"gyro_offset", "gyro_axes", "gyro_timestamps"}  # each clip has its own
     assert names["run"] - per_file - per_clip_gyro <= names["batch"]
 
 

@@ -56,6 +56,33 @@ def test_stabilising_from_the_gyro(tmp_path):
     assert summary["frames"] == 90 and out.is_file()
 
 
+def test_frame_times_on_the_gyro_clock_and_a_log_on_its_own(tmp_path):
+    # timestamps.csv dates the frames on the gyro's clock (ns): the offset is then ~0.
+    out = tmp_path / "stamped.mp4"
+    args = ["run", str(SAMPLE / "clip.mp4"), str(out), "--gyro", str(SAMPLE / "gyro.csv")]
+    args += ["--gyro-timestamps", str(SAMPLE / "timestamps.csv"), "--fov", "70", "-q", "--json"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    gyro = json.loads(result.stdout)["gyro"]
+    assert abs(gyro["offset_s"]) < 2e-3 and not gyro["searched_whole_log"]
+    # The same log on a boot clock 123456 s in: found by searching its whole span.
+    lines = (SAMPLE / "gyro.csv").read_text().splitlines()
+    shifted = tmp_path / "boot.csv"
+    shifted.write_text(
+        "".join(
+            f"{x},{y},{z},{int(t) + 123456 * 10**9}\n"
+            for x, y, z, t in (l.split(",") for l in lines)
+        )
+    )
+    args = ["run", str(SAMPLE / "clip.mp4"), str(tmp_path / "boot.mp4"), "--gyro", str(shifted)]
+    result = CliRunner().invoke(app, [*args, "--fov", "70", "-q", "--json"])
+    assert result.exit_code == 0, result.output
+    gyro = json.loads(result.stdout)["gyro"]
+    meta = json.loads((SAMPLE / "truth.json").read_text())
+    assert gyro["searched_whole_log"]
+    assert abs(gyro["offset_s"] - 123456.0 - meta["offset_s"]) < 2e-3
+
+
 def test_a_mismatched_gyro_is_refused(tmp_path):
     rng = np.random.default_rng(1)
     t = np.arange(0, 5, 1 / 400)

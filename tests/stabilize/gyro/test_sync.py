@@ -1,4 +1,5 @@
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +39,17 @@ def test_offset_axes_and_bias_are_found_from_the_truth(sample):
     assert so3.angular_error_deg(sync.R_cam_imu, np.array(meta["R_cam_imu"])) < 0.5
     np.testing.assert_allclose(sync.bias, meta["gyro_bias"], atol=1e-3)
     assert sync.correlation > 0.95
+
+
+def test_a_log_on_its_own_clock_is_found_over_its_whole_span(sample):
+    # An Android boot clock: the log starts 123456 s in, far outside any search range.
+    meta, times, R, log = sample
+    shifted = replace(log, times=log.times + 123456.0)
+    sync = synchronise(shifted, VisualTrack.from_rotations(times, R))
+    assert sync.searched_whole_log
+    assert abs(sync.offset - (meta["offset_s"] + 123456.0)) < 1e-3
+    assert sync.correlation > 0.95
+    assert not synchronise(log, VisualTrack.from_rotations(times, R)).searched_whole_log
 
 
 def test_given_offset_and_axes_are_kept(sample):

@@ -1,0 +1,61 @@
+"""Checks made before any decoding: can the output be written, and will the encoder take
+the options? A mistake found here costs a fraction of a second, not a whole pass.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import subprocess
+import tempfile
+from pathlib import Path
+
+from stabilize.video.binary import ffmpeg_exe
+from stabilize.video.containers import container_for
+from stabilize.video.encode import Encoding, output_args
+
+
+class OutputError(ValueError):
+    """An output that cannot be written where it was asked for; one line."""
+
+
+def check_writable(path: str | Path) -> None:
+    """That a file can be created beside ``path`` (its folder made if missing): by making
+    one there, the only test that answers for read-only disks, permissions and /proc."""
+    folder = Path(path).parent
+    existing = next((p for p in (folder, *folder.parents) if p.exists()), Path("/"))
+    if not existing.is_dir():
+        raise OutputError(f"{Path(path)}: {existing} is a file, not a folder")
+    target = folder if folder.exists() else existing
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".stabilize-check.", dir=target)
+    except OSError as err:
+        raise OutputError(f"cannot write in {target}: {describe(err)}") from None
+    os.close(fd)
+    os.unlink(probe)
+
+
+def check_encoder(path: str | Path, encoding: Encoding, size: tuple[int, int]) -> None:
+    """That FFmpeg encodes two frames of (H, W) ``size`` with these options into the
+    container ``path``'s suffix names; else FFmpeg's own first complaint, in one line."""
+    h, w = size
+    with tempfile.TemporaryDirectory(prefix="stabilize-check.") as tmp:
+        out = Path(tmp) / f"check{Path(path).suffix}"
+        cmd = [ffmpeg_exe(), "-hide_banner", "-loglevel", "error", "-nostdin", "-y"]
+        cmd += ["-f", "lavfi", "-i", f"color=black:s={w}x{h}:r=30", "-frames:v", "2"]
+        cmd += [*output_args(out, encoding, container_for(path)), str(out)]
+        result = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
+    if result.returncode != 0:
+        first = (result.stderr.strip().splitlines() or ["exit status " + str(result.returncode)])[0]
+        codec = encoding.codec_for(container_for(path))
+        raise OutputError(
+            f"FFmpeg cannot write {codec} (preset {encoding.preset}) as "
+            f"{Path(path).suffix or 'this file'}: {first}"
+        )
+
+
+def describe(err: OSError) -> str:
+    """An OS error's reason in words, the disk's fullness named."""
+    if err.errno == errno.ENOSPC:
+        return "the disk is full"
+    return err.strerror or str(err)

@@ -1,0 +1,31 @@
+"""The compiled kernels live in the user's cache folder, never beside the sources."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import rotation
+from rotation.cache import cache_dir
+
+
+def test_the_cache_is_the_users_folder_not_the_package(monkeypatch, tmp_path):
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.delenv("HOUGH_STABILIZE_CACHE", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    if sys.platform.startswith("linux"):
+        assert cache_dir() == tmp_path / "hough-stabilize" / "numba"
+    package = Path(rotation.__file__).parent
+    assert package not in cache_dir().parents
+    monkeypatch.setenv("HOUGH_STABILIZE_CACHE", str(tmp_path / "mine"))
+    assert cache_dir() == tmp_path / "mine" / "numba"
+
+
+def test_numba_is_pointed_there_before_any_kernel_is_defined(tmp_path):
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env["HOUGH_STABILIZE_CACHE"] = str(tmp_path)
+    code = "import rotation; from numba.core import config; print(config.CACHE_DIR)"
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.stdout.strip() == str(tmp_path / "numba"), out.stderr

@@ -1,0 +1,59 @@
+"""Help that teaches: the main job first, choices listed, no placeholders on flags, the
+axis letters and the gyro formats explained."""
+
+from __future__ import annotations
+
+import pytest
+from typer.testing import CliRunner
+
+from stabilize.cli import app, main
+from stabilize.gyro.readers import FORMATS
+
+RUNNER = CliRunner()
+
+
+def help_text(*command: str) -> str:
+    result = RUNNER.invoke(app, [*command, "--help"], env={"COLUMNS": "200"})
+    assert result.exit_code == 0
+    return result.output
+
+
+def test_the_top_level_help_shows_the_main_job_first():
+    text = help_text()
+    assert text.index("stabilize IN OUT") < text.index("Commands")
+
+
+def test_flags_have_no_placeholder_and_choices_are_listed():
+    text = help_text("run")
+    assert "<bool>" not in text
+    for choices in ("<dis|raft|raft-large>", "<adaptive|gaussian|lock>", "<auto|dynamic|none>"):
+        assert choices in text
+    assert "<none|side-by-side>" in text and "<cpu|cuda>" in text
+
+
+def test_axis_letters_and_gyro_formats_are_explained():
+    text = " ".join(help_text("run").split())
+    assert "lower case: the negative axis" in text
+    assert all(fmt in text for fmt in FORMATS)
+    assert ".gcsv, .csv, .txt" in " ".join(help_text("batch").split())
+
+
+def test_compare_takes_the_run_vocabulary_and_its_old_spellings(monkeypatch, capsys):
+    text = help_text("compare")
+    for option in ("--gyro-offset", "--gyro-axes", "--gyro-search", "--gyro-timestamps"):
+        assert option in text
+    assert "--offset" not in text.replace("--gyro-offset", "")  # hidden, still accepted
+    monkeypatch.setattr(
+        "sys.argv", ["stabilize", "compare", "x.mp4", "--gyro", "g", "--axes", "XYQ"]
+    )
+    with pytest.raises(SystemExit) as done:
+        main()
+    assert done.value.code == 2 and "--gyro-axes must be three letters" in capsys.readouterr().err
+
+
+def test_quiet_may_come_first(monkeypatch, capsys):
+    monkeypatch.setattr("sys.argv", ["stabilize", "-q", "nope.mp4", "out.mp4"])
+    with pytest.raises(SystemExit) as done:
+        main()
+    assert done.value.code == 2
+    assert capsys.readouterr().err.strip() == "error: nope.mp4: no such file"

@@ -1,0 +1,40 @@
+"""Outputs appear whole or not at all; a killed run's leftovers are swept, a running
+one's are not."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from stabilize.video import atomic_output
+from stabilize.video.atomic import sweep_stale
+
+
+def dead_pid() -> int:
+    child = subprocess.Popen([sys.executable, "-c", "pass"])
+    child.wait()
+    return child.pid
+
+
+def test_a_dead_runs_leftover_is_swept_and_a_live_ones_kept(tmp_path):
+    dead = tmp_path / f".out.{dead_pid()}.abcd1234.partial.mp4"
+    live = tmp_path / f".out.{os.getpid()}.efgh5678.partial.mp4"
+    other = tmp_path / f".other.{dead_pid()}.ijkl9012.partial.mp4"
+    for path in (dead, live, other):
+        path.write_bytes(b"half a video")
+    with atomic_output(tmp_path / "out.mp4") as tmp:
+        assert f".{os.getpid()}." in tmp.name
+        tmp.write_bytes(b"video")
+    assert not dead.exists() and live.exists() and other.exists()  # only its own name
+    assert (tmp_path / "out.mp4").read_bytes() == b"video"
+    assert sweep_stale(tmp_path) == 1 and not other.exists() and live.exists()
+
+
+def test_a_failed_block_leaves_nothing(tmp_path):
+    with pytest.raises(RuntimeError), atomic_output(tmp_path / "out.mp4") as tmp:
+        tmp.write_bytes(b"half")
+        raise RuntimeError("encoder died")
+    assert list(tmp_path.iterdir()) == []

@@ -1,0 +1,123 @@
+"""Every stream kept: audio tracks, subtitle tracks, chapters and metadata, checked by
+count and by content, into MKV and MP4 outputs; and the container the suffix names."""
+
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+import av
+import numpy as np
+import pytest
+
+from stabilize import Settings, stabilize_video
+from stabilize.video import Encoding, FrameWriter, ffmpeg_exe, probe
+from stabilize.video.containers import container_for
+from stabilize.video.streams import keep_streams
+
+SUBTITLES = {"eng": "Hello street", "fra": "Bonjour la rue"}
+CHAPTERS = ("Start", "Corner")
+
+
+@pytest.fixture(scope="module")
+def rich(shaky, tmp_path_factory) -> dict[str, Path]:
+    """The shaky clip with 2 audio tracks, 2 subtitle tracks, chapters and metadata, as
+    MKV (SubRip) and MP4 (mov_text)."""
+    folder = tmp_path_factory.mktemp("rich")
+    for lang, text in SUBTITLES.items():
+        (folder / f"{lang}.srt").write_text(f"1\n00:00:00,200 --> 00:00:01,500\n{text}\n")
+    (folder / "chapters.txt").write_text(
+        ";FFMETADATA1\ntitle=Street walk\n"
+        f"[CHAPTER]\nTIMEBASE=1/1000\nSTART=0\nEND=1000\ntitle={CHAPTERS[0]}\n"
+        f"[CHAPTER]\nTIMEBASE=1/1000\nSTART=1000\nEND=2000\ntitle={CHAPTERS[1]}\n"
+    )
+    mkv = folder / "rich.mkv"
+    cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(shaky)]
+    cmd += ["-f", "lavfi", "-i", "sine=frequency=880:duration=2"]
+    cmd += ["-i", str(folder / "eng.srt"), "-i", str(folder / "fra.srt")]
+    cmd += ["-i", str(folder / "chapters.txt")]
+    cmd += ["-map", "0:v", "-map", "0:a", "-map", "1:a", "-map", "2", "-map", "3"]
+    cmd += ["-map_metadata", "4", "-map_chapters", "4", "-c:v", "copy", "-c:a", "aac"]
+    cmd += ["-c:s", "srt", "-metadata", "creation_time=2024-05-01T10:00:00Z"]
+    cmd += ["-metadata", "location=+48.8584+002.2945/"]
+    cmd += ["-metadata:s:a:0", "language=eng", "-metadata:s:a:1", "language=fra"]
+    cmd += ["-metadata:s:a:1", "title=Commentary"]
+    cmd += ["-metadata:s:s:0", "language=eng", "-metadata:s:s:1", "language=fra", str(mkv)]
+    subprocess.run(cmd, check=True)
+    mp4 = folder / "rich.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(mkv), "-map", "0", "-c", "copy"]
+    subprocess.run(
+        [*cmd, "-c:s", "mov_text", "-movflags", "use_metadata_tags", str(mp4)], check=True
+    )
+    return {"mkv": mkv, "mp4": mp4}
+
+
+def subtitle_text(path: Path, k: int) -> str:
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(path), "-map", f"0:s:{k}", "-f", "srt", "-"]
+    return subprocess.run(cmd, capture_output=True, text=True, check=True).stdout
+
+
+def streams(path: Path) -> dict[str, list[dict]]:
+    with av.open(str(path)) as c:
+        return {
+            kind: [dict(s.metadata) for s in c.streams if s.type == kind]
+            for kind in ("video", "audio", "subtitle")
+        } | {"file": [dict(c.metadata)], "chapters": [dict(ch) for ch in c.chapters()]}
+
+
+@pytest.mark.parametrize("source", ["mkv", "mp4"])
+@pytest.mark.parametrize("suffix", [".mkv", ".mp4"])
+def test_every_track_chapter_and_tag_is_kept(rich, tmp_path, source, suffix):
+    out = tmp_path / f"out{suffix}"
+    summary, _ = stabilize_video(rich[source], out, Settings(fov=70.0))
+    got = streams(out)
+    assert len(got["video"]) == 1 and summary["frames"] == 60
+    assert [s.get("language") for s in got["audio"]] == ["eng", "fra"]
+    assert [s.get("language") for s in got["subtitle"]] == ["eng", "fra"]
+    assert any("Commentary" in s.values() for s in got["audio"][1:])
+    assert [ch["metadata"]["title"] for ch in got["chapters"]] == list(CHAPTERS)
+    tags = {k.lower(): v for k, v in got["file"][0].items()}
+    assert tags["title"] == "Street walk" and tags["location"] == "+48.8584+002.2945/"
+    for k, text in enumerate(SUBTITLES.values()):
+        assert text in subtitle_text(out, k)
+    if source == suffix[1:]:
+        assert not summary["notices"]  # everything fitted as it was
+    else:  # SubRip ↔ mov_text, said so
+        assert len(summary["notices"]) == 2 and all("→" in n for n in summary["notices"])
+
+
+def test_webm_transcodes_what_it_cannot_hold_and_says_so(rich, tmp_path):
+    info = probe(rich["mp4"])
+    mux = keep_streams(info, container_for("out.webm"))
+    assert any("aac → libopus" in n for n in mux.notices)
+    assert any("mov_text → webvtt" in n for n in mux.notices)
+    out = tmp_path / "out.webm"
+    stabilize_video(rich["mp4"], out, Settings(fov=70.0))
+    with av.open(str(out)) as c:
+        assert c.format.name.startswith("matroska")
+        assert c.streams.video[0].codec_context.name == "vp9"
+        assert [s.codec_context.name for s in c.streams.audio] == ["opus", "opus"]
+        assert len(c.streams.subtitles) == 2
+
+
+def test_avi_cannot_hold_subtitles_and_says_so(rich):
+    mux = keep_streams(probe(rich["mkv"]), container_for("out.avi"))
+    assert sum("left out subtitle" in n for n in mux.notices) == 2
+
+
+def test_hevc_in_mp4_is_tagged_hvc1(tmp_path):
+    out = tmp_path / "h.mp4"
+    encoding = Encoding(codec="libx265", preset="ultrafast")
+    with FrameWriter(out, (64, 64), 30.0, encoding) as writer:
+        for _ in range(3):
+            writer.write(np.zeros((64, 64, 3), np.uint8))
+    assert probe(out).streams[0].tag == "hvc1"
+
+
+MUXERS = {".mp4": "mp4", ".m4v": "mp4", ".mov": "mov", ".mkv": "matroska", ".webm": "webm"}
+MUXERS |= {".avi": "avi", ".ts": "mpegts", ".unknown": ""}
+
+
+@pytest.mark.parametrize(("suffix", "muxer"), list(MUXERS.items()))
+def test_the_suffix_names_the_container(suffix, muxer):
+    assert container_for(f"out{suffix.upper()}").muxer == muxer
