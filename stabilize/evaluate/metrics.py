@@ -9,6 +9,9 @@
   energy in the 2nd–6th FFT components, DC excluded. Higher is steadier. Reported
   separately and as the minimum of the two.
 * **ITF**: the mean PSNR of consecutive frames, in dB.
+* **Residual shake** (:mod:`stabilize.evaluate.shake`): the RMS of the high-passed
+  frame-to-frame similarity motion, in px at the clip's width, and its in-plane rotation
+  in degrees. What a viewer sees as shake; lower is steadier.
 
 Registrations are ORB features, spread evenly over a grid, matched with a ratio test,
 then a RANSAC homography; frames with too few features fall back to the identity (and are
@@ -23,6 +26,8 @@ from dataclasses import asdict, dataclass
 import cv2
 import numpy as np
 from numpy.typing import NDArray
+
+from stabilize.evaluate.shake import residual_shake, similarity_motion
 
 MIN_MATCHES = 12
 FEATURES = 2000  # ORB features per frame for registration
@@ -164,6 +169,8 @@ class ClipMetrics:
     stability: float
     itf_db: float
     registration_failures: int
+    residual_shake_px: float  # stabilize.evaluate.shake: RMS of the high-passed 2-D motion
+    residual_shake_deg: float
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -178,6 +185,8 @@ class _Clip:
         self.itf: list[float] = []
         self.previous: tuple | None = None  # (features, grey) of the last frame
         self.frames = 0
+        self.motions: list[NDArray] = []  # frame-to-frame similarities (dx, dy, dθ, d ln s)
+        self.shape: tuple[int, ...] = ()
 
     def add(self, frame: NDArray[np.uint8]):
         """Register a frame against the previous one; returns its features."""
@@ -185,13 +194,20 @@ class _Clip:
         grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         if self.previous is not None:
             self.inter.append(self.reg.homography(self.previous[0], feat))
+            motion = similarity_motion(self.previous[0], feat, self.reg.matcher)
+            self.motions.append(np.zeros(4) if motion is None else motion)
             self.itf.append(psnr(self.previous[1], grey))
         self.previous = (feat, grey)
         self.frames += 1
+        self.shape = frame.shape
         return feat
 
-    def metrics(self, scales: list[float], ratios: list[float]) -> ClipMetrics:
+    def metrics(self, scales: list[float], ratios: list[float], fps: float) -> ClipMetrics:
         st, sr = stability(self.inter)
+        h, w = self.shape[:2] if self.shape else (0, 0)
+        shake = residual_shake(
+            np.array(self.motions).reshape(-1, 4), w, fps, ((w - 1) / 2, (h - 1) / 2)
+        )
         return ClipMetrics(
             frames=self.frames,
             cropping_ratio=float(np.mean(scales)) if scales else 1.0,
@@ -201,11 +217,15 @@ class _Clip:
             stability=float(min(st, sr)),
             itf_db=float(np.mean(self.itf)) if self.itf else float("nan"),
             registration_failures=self.reg.failures,
+            residual_shake_px=shake[0],
+            residual_shake_deg=shake[1],
         )
 
 
 def evaluate_pair(
-    original: Iterable[NDArray[np.uint8]], stabilised: Iterable[NDArray[np.uint8]]
+    original: Iterable[NDArray[np.uint8]],
+    stabilised: Iterable[NDArray[np.uint8]],
+    fps: float = 30.0,
 ) -> tuple[ClipMetrics, ClipMetrics]:
     """Metrics of the original and of the stabilised clip, in one pass over both.
 
@@ -222,12 +242,12 @@ def evaluate_pair(
         scale, ratio = scale_and_distortion(H, center)
         scales.append(scale)
         ratios.append(ratio)
-    return before.metrics([], []), after.metrics(scales, ratios)
+    return before.metrics([], [], fps), after.metrics(scales, ratios, fps)
 
 
-def evaluate(frames: Iterable[NDArray[np.uint8]]) -> ClipMetrics:
+def evaluate(frames: Iterable[NDArray[np.uint8]], fps: float = 30.0) -> ClipMetrics:
     """Metrics of one clip on its own (cropping ratio and distortion are 1)."""
     clip = _Clip()
     for frame in frames:
         clip.add(frame)
-    return clip.metrics([], [])
+    return clip.metrics([], [], fps)

@@ -105,6 +105,7 @@ CASES = {
     ),
     "VP9 WebM input": Case((), 0, early=False, source="vp9.webm", container="mp4"),
     "ProRes MOV input": Case((), 0, early=False, source="prores.mov", container="mp4"),
+    "AV1 input": Case((), 0, early=False, source="av1.mkv", container="mp4"),
 }
 if shutil.which("nvidia-smi"):  # pragma: no cover - a machine with a GPU runs it
     CASES.pop("cuda without a GPU")
@@ -118,6 +119,7 @@ TRANSCODES = {
     "hevc.mp4": ["-c:v", "libx265", "-preset", "ultrafast", "-tag:v", "hvc1", "-c:a", "copy"],
     "vp9.webm": ["-c:v", "libvpx-vp9", "-deadline", "realtime", "-c:a", "libopus"],
     "prores.mov": ["-c:v", "prores_ks", "-c:a", "copy"],
+    "av1.mkv": ["-c:v", "libsvtav1", "-preset", "12", "-c:a", "copy"],
     "odd": ["-vf", "crop=319:179:0:0", "-c:v", "libx264", "-pix_fmt", "yuv444p", "-c:a", "copy"],
     "one frame": ["-frames:v", "1", "-an"],
 }

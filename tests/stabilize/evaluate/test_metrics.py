@@ -31,6 +31,22 @@ def test_a_steady_clip_ranks_above_a_shaken_one(shaken, panning):
     assert smooth.itf_db > shaky.itf_db + 3
 
 
+def test_the_residual_shake_ranks_a_steady_clip_above_a_shaken_one(shaken, panning):
+    still = evaluate([shaken[0]] * len(shaken))
+    smooth, shaky = evaluate(panning), evaluate(shaken)
+    assert still.residual_shake_px < 0.05  # registration noise only
+    assert smooth.residual_shake_px < 0.25 * shaky.residual_shake_px
+    assert shaky.residual_shake_px > 1.0 and shaky.residual_shake_deg > 0.01
+
+
+def test_the_residual_shake_is_in_pixels_of_the_motion(shaken):
+    # Frames shifted by 0, 2, 0, 2, ... px: each frame-to-frame motion is ±2 px, which the
+    # low-pass (0.5 s) averages to about 0, so all of it is shake: 2 px RMS.
+    jittered = [np.roll(shaken[0], 2 * (k % 2), axis=1) for k in range(60)]
+    cropped = [f[:, 8:-8] for f in jittered]
+    assert evaluate(cropped).residual_shake_px == pytest.approx(2.0, rel=0.1)
+
+
 def test_a_zoomed_crop_ranks_below_an_uncropped_one(shaken):
     def zoom(frame: np.ndarray, z: float) -> np.ndarray:
         h, w = frame.shape[:2]

@@ -65,25 +65,45 @@ def streams(path: Path) -> dict[str, list[dict]]:
         } | {"file": [dict(c.metadata)], "chapters": [dict(ch) for ch in c.chapters()]}
 
 
-@pytest.mark.parametrize("source", ["mkv", "mp4"])
-@pytest.mark.parametrize("suffix", [".mkv", ".mp4"])
-def test_every_track_chapter_and_tag_is_kept(rich, tmp_path, source, suffix):
-    out = tmp_path / f"out{suffix}"
+PAIRS = [(src, suffix) for src in ("mkv", "mp4") for suffix in (".mkv", ".mp4")]
+
+
+@pytest.fixture(scope="module", params=PAIRS, ids=lambda p: f"{p[0]}-to-{p[1][1:]}")
+def kept(request, rich, tmp_path_factory) -> tuple[Path, dict, dict]:
+    """(output, summary, its streams) of the rich clip stabilised into each container."""
+    source, suffix = request.param
+    out = tmp_path_factory.mktemp("kept") / f"out{suffix}"
     summary, _ = stabilize_video(rich[source], out, Settings(fov=70.0))
-    got = streams(out)
-    assert len(got["video"]) == 1 and summary["frames"] == 60
-    assert [s.get("language") for s in got["audio"]] == ["eng", "fra"]
-    assert [s.get("language") for s in got["subtitle"]] == ["eng", "fra"]
-    assert any("Commentary" in s.values() for s in got["audio"][1:])
-    assert [ch["metadata"]["title"] for ch in got["chapters"]] == list(CHAPTERS)
-    tags = {k.lower(): v for k, v in got["file"][0].items()}
-    assert tags["title"] == "Street walk" and tags["location"] == "+48.8584+002.2945/"
-    for k, text in enumerate(SUBTITLES.values()):
-        assert text in subtitle_text(out, k)
     if source == suffix[1:]:
         assert not summary["notices"]  # everything fitted as it was
     else:  # SubRip ↔ mov_text, said so
         assert len(summary["notices"]) == 2 and all("→" in n for n in summary["notices"])
+    return out, summary, streams(out) | {"source": [streams(rich[source])["file"][0]]}
+
+
+def test_every_audio_track_is_kept(kept):
+    _, summary, got = kept
+    assert len(got["video"]) == 1 and summary["frames"] == 60
+    assert [s.get("language") for s in got["audio"]] == ["eng", "fra"]
+    assert any("Commentary" in s.values() for s in got["audio"][1:])
+
+
+def test_every_subtitle_track_is_kept_with_its_text(kept):
+    out, _, got = kept
+    assert [s.get("language") for s in got["subtitle"]] == ["eng", "fra"]
+    for k, text in enumerate(SUBTITLES.values()):
+        assert text in subtitle_text(out, k)
+
+
+def test_the_chapters_are_kept(kept):
+    assert [ch["metadata"]["title"] for ch in kept[2]["chapters"]] == list(CHAPTERS)
+
+
+def test_the_files_metadata_is_kept(kept):
+    tags = {k.lower(): v for k, v in kept[2]["file"][0].items()}
+    assert tags["title"] == "Street walk" and tags["location"] == "+48.8584+002.2945/"
+    if "creation_time" in kept[2]["source"][0]:
+        assert tags["creation_time"].startswith("2024-05-01T10:00:00")
 
 
 def test_webm_transcodes_what_it_cannot_hold_and_says_so(rich, tmp_path):
