@@ -126,15 +126,19 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     gyro log. Raises ValueError (its subclasses name the file) on the first problem."""
     _check_output(src, dst, overwrite)
     check_settings(settings)
+    log = None
+    if settings.gyro:  # first: reading a log takes milliseconds
+        from stabilize.gyro.load import load_gyro
+
+        log = load_gyro(settings)
     info = probe(src)
+    if settings.gyro_timestamps:
+        from stabilize.gyro.readers import sensor_frame_times
+
+        sensor_frame_times(settings.gyro_timestamps, 0, len(frame_times(src, info.input_args)))
     check_writable(dst)
     check_encoder(dst, settings.encoding, encoded_size(info, settings))
     lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
-    log = None
-    if settings.gyro:
-        from stabilize.gyro.path import load_gyro
-
-        log = load_gyro(settings, len(frame_times(src, info.input_args)))
     mux = keep_streams(info, container_for(dst), info.video_delay)
     notices = mux.notices
     if not settings.size and frame_size(info, settings) != info.size:

@@ -121,7 +121,7 @@ def _comparison(params: dict, bar: ProgressFactory):
     """The comparison the parsed options ``params`` ask for."""
     from stabilize.evaluate.compare import compare_video
     from stabilize.gyro import read_gyro
-    from stabilize.gyro.path import readout_seconds
+    from stabilize.gyro.load import readout_seconds
     from stabilize.gyro.sync import SyncOptions
     from stabilize.warp.lens import read_lens_profile
 

@@ -9,6 +9,7 @@ through click's ``ctx.params``, never listed a second time.
 
 from __future__ import annotations
 
+import shutil
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -170,7 +171,9 @@ def flow_settings(flow_name: str, raft_weights: Path | None, device: str, **opti
     """Settings with the flow backend and device checked; options are Settings fields
     (fov, smooth, crop, ...)."""
     if device == "cuda":
-        import torch
+        if not (Path("/proc/driver/nvidia/version").exists() or shutil.which("nvidia-smi")):
+            fail("--device cuda was asked for, but this machine has no NVIDIA driver")
+        import torch  # about 1.5 s: only where a driver could answer
 
         if not torch.cuda.is_available():
             fail("--device cuda was asked for, but torch sees no CUDA device")

@@ -9,10 +9,11 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
+from stabilize.gyro.load import readout_seconds
 from stabilize.gyro.log import GyroLog
-from stabilize.gyro.readers import read_gyro, sensor_frame_times
+from stabilize.gyro.readers import sensor_frame_times
 from stabilize.gyro.rolling_shutter import frame_rotations, row_turns
-from stabilize.gyro.source import gyro_rotations, lowpass
+from stabilize.gyro.source import gyro_rotations
 from stabilize.gyro.sync import SyncOptions
 from stabilize.motion.track import VisualTrack
 from stabilize.settings import Settings
@@ -20,21 +21,11 @@ from stabilize.warp.lens import Lens
 from stabilize.warp.rolling import RollingShutter
 
 
-def load_gyro(settings: Settings, frames: int) -> GyroLog:
-    """The log ``settings`` name, read, checked and filtered before any work is done;
-    with ``gyro_timestamps``, that file is checked to hold the clip's ``frames`` times."""
-    log = read_gyro(settings.gyro, settings.gyro_format)
-    if settings.gyro_timestamps:
-        sensor_frame_times(settings.gyro_timestamps, 0, frames)
-    readout_seconds(settings.readout_ms, None)
-    return lowpass(log, settings.gyro_lpf) if settings.gyro_lpf else log
-
-
 def gyro_path(
     settings: Settings, log: GyroLog, track: VisualTrack, height: int, lens: Lens | None = None
 ) -> tuple[NDArray, RollingShutter | None, dict]:
     """(R_t, the rolling-shutter turns or None, a summary) from a gyro ``log``
-    (:func:`load_gyro`), synchronised against the visual ``track``. With
+    (:func:`stabilize.gyro.load.load_gyro`), synchronised against the visual ``track``. With
     ``gyro_timestamps`` the frames are dated on the gyro's clock by that file."""
     if settings.gyro_timestamps:
         stamps = sensor_frame_times(settings.gyro_timestamps, 0, len(track.times))
@@ -62,16 +53,3 @@ def gyro_path(
             "searched_whole_log": sync.searched_whole_log,
         },
     )
-
-
-def readout_seconds(option: float | str | None, from_log: float | None) -> float | None:
-    """The readout to use: ``--readout-ms`` (a number, or 'auto': estimate it), else the
-    log's own value, else 0 (no rolling-shutter correction). None means 'estimate'."""
-    if option is None:
-        return from_log or 0.0
-    if option == "auto":
-        return None
-    value = float(option)
-    if not 0.0 <= value < 1000.0:
-        raise ValueError(f"--readout-ms must be between 0 and 1000 ms, got {option}")
-    return value / 1000.0

@@ -8,7 +8,7 @@ from rotation import so3
 from stabilize.cli import app
 from stabilize.gyro import GyroError, GyroLog, read_gyro
 from stabilize.gyro.export import write_gcsv
-from stabilize.gyro.source import lowpass
+from stabilize.gyro.load import lowpass
 from stabilize.gyro.sync import visual_rates
 from tests.stabilize.helpers import SAMPLE
 
