@@ -145,8 +145,19 @@ class HoughEstimator:
         chunks side by side. (A numba ``prange`` kernel did the same as fast, but took
         twice as long to compile on the first run: 21 s against 11 s.)
         """
-        flows = check_flows(flows, self.size, stacked=True)
-        u, v, valid = sample_flows(flows, self.grid)
+        return self.estimate_samples(*self.samples(flows))
+
+    def samples(self, flows: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+        """The vectors the estimator reads from a stack (N, H, W, 2): u, v (N, M) at the
+        sample grid (:attr:`grid`), and their validity. About 5 KB per field, so a
+        clip's can be kept and estimated again (another focal length, other bands)."""
+        return sample_flows(check_flows(flows, self.size, stacked=True), self.grid)
+
+    def estimate_samples(self, u: NDArray, v: NDArray, valid: NDArray) -> list[RotationEstimate]:
+        """Rotations of sampled fields (N, M) (:meth:`samples`); what
+        :meth:`estimate_many` does after sampling."""
+        u, v = np.asarray(u, np.float64), np.asarray(v, np.float64)
+        valid = np.asarray(valid, np.bool_)
         n = len(u)
         threads = max(1, min(n, get_num_threads()))
         chunks = min(n, 2 * threads)

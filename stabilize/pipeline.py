@@ -25,7 +25,8 @@ import flow
 from rotation import so3
 from rotation.camera import intrinsics
 from stabilize.gyro.log import GyroLog
-from stabilize.motion.estimate import READOUT_BANDS, estimate_rotations
+from stabilize.motion.estimate import READOUT_BANDS
+from stabilize.motion.focal import estimate_motion
 from stabilize.motion.repair import repair_unreliable
 from stabilize.motion.track import VisualTrack
 from stabilize.path.plan import plan_path
@@ -82,12 +83,14 @@ def stabilize_video(
     bands = READOUT_BANDS if settings.gyro and settings.readout_ms == "auto" else 0
     times = frame_times(src, job.info.input_args)
     estimating = bar("estimating", max(len(times) - 1, 0))
-    track = estimate_rotations(
+    track, focal = estimate_motion(
         src, job.info, settings, estimating, times, bands=bands, lens=job.lens
     )
+    if focal.note:
+        (notify or (lambda _: None))(f"focal length: {focal.note}")
     R, rolling, repaired, gyro_summary = _rotations(settings, job, track)
     t_estimate = time.perf_counter() - start
-    K = _camera_matrix(settings, job.info, job.lens)
+    K = _camera_matrix(focal.px, job.info, job.lens)
     planned = plan_path(
         track.times, R, track.support, K, job.info.size, settings, rolling, job.lens
     )
@@ -102,6 +105,7 @@ def stabilize_video(
         "frames": frames,
         "size": [job.info.width, job.info.height],
         "focal_px": float(K[0, 0]),
+        "focal": focal.summary(),
         "zoom": float(planned.zoom.max()),
         "mean_support": float(np.mean(track.support)),
         "repaired_frames": repaired,
@@ -192,7 +196,7 @@ def check_settings(settings: Settings) -> None:
         (settings.method in METHODS, f"--method must be one of {', '.join(METHODS)}"),
         (settings.crop in CROP_MODES, f"--crop must be one of {', '.join(CROP_MODES)}"),
         (settings.device in ("cpu", "cuda"), "--device must be cpu or cuda"),
-        (settings.fov is None or 0 < settings.fov < 180, "--fov must be between 0 and 180°"),
+        (settings.fov in (None, "auto") or 0 < settings.fov < 180, "--fov must be 0–180° or auto"),
         (settings.focal is None or settings.focal > 0, "--focal must be a positive number"),
         (settings.smooth > 0, "--smooth must be positive"),
         (settings.max_zoom >= 1.0, "--max-zoom must be at least 1"),
@@ -225,9 +229,9 @@ def _check_output(src: Path, dst: Path, overwrite: bool) -> None:
         raise FileExistsError(f"{dst} exists (use --overwrite to replace it)")
 
 
-def _camera_matrix(settings: Settings, info: VideoInfo, lens: Lens | None) -> NDArray:
-    """K at the video's size: from the settings' focal length, or the pinhole part of the
-    lens profile (the homographies reported are then that part's)."""
+def _camera_matrix(focal: float, info: VideoInfo, lens: Lens | None) -> NDArray:
+    """K at the video's size: of the focal length (px), or the pinhole part of the lens
+    profile (the homographies reported are then that part's)."""
     if lens is None:
-        return intrinsics(settings.focal_px(info.width), info.size)
+        return intrinsics(focal, info.size)
     return intrinsics(lens.K[0, 0], info.size, (lens.K[0, 2], lens.K[1, 2]))

@@ -30,7 +30,7 @@ class Settings:
 
     flow: str = "dis"  # flow backend (flow.BACKENDS)
     flow_options: dict = field(default_factory=dict)
-    fov: float | None = None  # horizontal field of view, degrees
+    fov: float | str | None = None  # horizontal field of view, degrees; "auto": estimated
     focal: float | None = None  # pixels; overrides fov
     smooth: float = 0.5  # smoothing time constant, s
     method: str = "adaptive"  # smoothing method (stabilize.path.smoothing.METHODS)
@@ -58,7 +58,13 @@ class Settings:
             return float(self.focal)
         from rotation.camera import focal_from_fov  # the estimator's package is heavy
 
-        return focal_from_fov(self.fov or DEFAULT_HFOV, width)
+        fov = self.fov if isinstance(self.fov, int | float) else DEFAULT_HFOV
+        return focal_from_fov(fov, width)
+
+    @property
+    def fov_given(self) -> bool:
+        """Whether the focal length was given (``fov`` in degrees, or ``focal``)."""
+        return self.focal is not None or isinstance(self.fov, int | float)
 
 
 DEFAULTS = Settings()

@@ -28,6 +28,7 @@ from stabilize.cli.options import (
     QuietOption,
     RaftWeightsOption,
     axes_matrix,
+    field_of_view,
     flow_settings,
     readout,
 )
@@ -128,7 +129,9 @@ def _comparison(params: dict, bar: ProgressFactory):
     flow_name, weights, fov, focal = (
         params[k] for k in ("flow_name", "raft_weights", "fov", "focal")
     )
-    settings = flow_settings(flow_name, weights, "cpu", fov=fov, focal=focal, max_deg=15.0)
+    settings = flow_settings(
+        flow_name, weights, "cpu", fov=field_of_view(fov), focal=focal, max_deg=15.0
+    )
     R_cam_imu = axes_matrix(params["gyro_axes"])
     calibrate = params["calibrate_focal"]
     log = read_gyro(params["gyro"], params["gyro_format"])

@@ -34,11 +34,11 @@ DeviceOption = Annotated[
     Literal["cpu", "cuda"], typer.Option(help="Where RAFT flow and the frame warps run.")
 ]
 FovOption = Annotated[
-    float | None,
+    str | None,
     typer.Option(
-        min=1.0,
-        max=179.0,
-        help="Horizontal field of view, deg (default 69: a phone's main camera).",
+        help="Horizontal field of view, degrees (1–179), or 'auto': estimated from the "
+        "clip's own motion. Default: the file's metadata (a phone's 35 mm equivalent), "
+        "else 69° (a phone's main camera).",
     ),
 ]
 FocalOption = Annotated[
@@ -145,7 +145,7 @@ def job_settings(params: Mapping[str, Any]) -> Settings:
         params["flow_name"],
         params["raft_weights"],
         params["device"],
-        fov=params["fov"],
+        fov=field_of_view(params["fov"]),
         focal=params["focal"],
         smooth=params["smooth"],
         method="lock" if params["lock"] else params["method"],
@@ -181,6 +181,19 @@ def flow_settings(flow_name: str, raft_weights: Path | None, device: str, **opti
     if flow_name.startswith("raft"):
         flow_options = {"weights": raft_weights, "device": device}
     return Settings(flow=flow_name, flow_options=flow_options, device=device, **options)
+
+
+def field_of_view(text: str | None) -> float | str | None:
+    """--fov: degrees across, between 1 and 179, or 'auto'."""
+    if text is None or text == "auto":
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        fail(f"--fov takes degrees (1–179) or 'auto', got {text!r}")
+    if not 1.0 <= value <= 179.0:
+        fail(f"--fov must be between 1 and 179 degrees, got {text}")
+    return value
 
 
 def output_size(text: str | None) -> tuple[int, int] | None:

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from stabilize.cli.app import announce_compiling, app, fail, run_or_fail
+from stabilize.cli.app import announce_compiling, app, fail, notice, run_or_fail
 from stabilize.cli.options import (
     DeviceOption,
     FlowOption,
@@ -15,6 +15,7 @@ from stabilize.cli.options import (
     OverwriteOption,
     QuietOption,
     RaftWeightsOption,
+    field_of_view,
     flow_settings,
 )
 from stabilize.settings import DEFAULTS
@@ -47,8 +48,8 @@ def rotations(
     """Estimate only: the camera rotation R_t of every frame pair (radians)."""
     from rotation import so3
     from stabilize.cli.bars import with_bars
-    from stabilize.motion.estimate import estimate_rotations
     from stabilize.motion.files import write_rotations
+    from stabilize.motion.focal import estimate_motion
     from stabilize.video import atomic_output, probe
     from stabilize.video.preflight import check_writable
 
@@ -59,14 +60,15 @@ def rotations(
         if target.exists() and not overwrite:
             fail(f"{target} exists (use --overwrite to replace it)")
         run_or_fail(lambda target=target: check_writable(target))
-    settings = flow_settings(flow_name, raft_weights, device, fov=fov, focal=focal)
+    settings = flow_settings(flow_name, raft_weights, device, fov=field_of_view(fov), focal=focal)
     info = run_or_fail(lambda: probe(input_path))
 
     def estimate(bar):
-        return estimate_rotations(input_path, info, settings, bar("estimating", None))
+        return estimate_motion(input_path, info, settings, bar("estimating", None))
 
     announce_compiling()
-    track = run_or_fail(lambda: with_bars(estimate, quiet=quiet))
+    track, focal = run_or_fail(lambda: with_bars(estimate, quiet=quiet))
+    notice(f"focal length {focal.px:.1f} px ({focal.fov_deg:.1f}° across, {focal.source})")
     if output is not None:
         with atomic_output(output, overwrite=overwrite) as tmp:
             write_rotations(tmp, track.times[:-1], so3.log_so3(track.rotations), track.support)

@@ -24,7 +24,8 @@ from stabilize.gyro import GyroLog, integrate_rotations
 from stabilize.gyro.axes import axes_code
 from stabilize.gyro.focal import focal_from_gyro
 from stabilize.gyro.sync import MIN_CORRELATION, IntervalRates, Sync, SyncOptions, visual_rates
-from stabilize.motion.estimate import READOUT_BANDS, estimate_rotations
+from stabilize.motion.estimate import READOUT_BANDS
+from stabilize.motion.focal import estimate_motion
 from stabilize.motion.track import VisualTrack
 from stabilize.progress import ProgressFactory, no_progress
 from stabilize.settings import Settings
@@ -137,20 +138,21 @@ def compare_video(
     """
     bands = READOUT_BANDS if options.readout is None else 0
 
-    def estimate_and_sync(settings: Settings) -> tuple[VisualTrack, Sync]:
+    def estimate_and_sync(settings: Settings) -> tuple[VisualTrack, Sync, float]:
         advance = progress("estimating", len(times) - 1) if progress else no_progress
-        track = estimate_rotations(video, info, settings, advance, times, bands=bands, lens=lens)
-        return track, options.synchronise(log, track)
+        track, focal = estimate_motion(
+            video, info, settings, advance, times, bands=bands, lens=lens
+        )
+        return track, options.synchronise(log, track), focal.px
 
-    track, sync = estimate_and_sync(settings)
+    track, sync, focal = estimate_and_sync(settings)
     for _ in range(FOCAL_ROUNDS if calibrate_focal else 0):
-        old = settings.focal_px(info.width)
-        fitted = focal_from_gyro(track, log, sync, old)
-        settings = replace(settings, focal=fitted)
-        track, sync = estimate_and_sync(settings)
+        fitted = focal_from_gyro(track, log, sync, focal)
+        old, focal = focal, fitted
+        track, sync, _ = estimate_and_sync(replace(settings, focal=fitted))
         if abs(fitted / old - 1.0) < FOCAL_CONVERGED:
             break
-    return compare(track, log, sync, settings.focal_px(info.width))
+    return compare(track, log, sync, focal)
 
 
 def write_comparison(folder: str | Path, result: Comparison) -> None:

@@ -21,7 +21,7 @@ import flow
 from flow.resize import WorkingSize
 from rotation import HoughEstimator
 from rotation.camera import scale_intrinsics
-from stabilize.motion.track import VisualTrack, mean_row
+from stabilize.motion.track import Samples, VisualTrack, mean_row
 from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoError, VideoInfo, frame_times, read_frames
@@ -40,8 +40,10 @@ def estimate_rotations(
     *,
     bands: int = 0,
     lens: Lens | None = None,
+    keep_samples: bool = False,
 ) -> VisualTrack:
-    """Pass 1: the clip's rotations, frames streamed at the working size.
+    """Pass 1: the clip's rotations, frames streamed at the working size; with
+    ``keep_samples``, the track keeps the flow vectors they came from (``samples``).
 
     Frame times are the container's timestamps unless given (e.g. from a sensor log).
     ``bands`` > 0 also estimates each pair's rotation from that many horizontal bands of
@@ -54,7 +56,14 @@ def estimate_rotations(
     ws = flow.working_size(info.size)
     backend = flow.get(settings.flow, **settings.flow_options)
     estimator, frames = _estimator_and_frames(path, info, settings, ws, lens)
-    found = _vote(estimator, backend.many(frames), ws.size[0], bands, progress)
+    found: list[list[tuple]] = [[] for _ in range(bands + 1)]  # whole frame, then bands
+    kept: list[tuple] = []
+    masks = band_masks(estimator, ws.size[0], bands)
+    for u, v, valid in _sampled(estimator, backend.many(frames)):
+        _vote(estimator, u, v, valid, masks, found)
+        if keep_samples:
+            kept.append((u.astype(np.float32), v.astype(np.float32), valid))
+        progress(len(u))
     n = len(found[0]) + 1
     if n < 2:
         raise VideoError(f"{path}: fewer than two frames decoded; nothing to stabilise")
@@ -65,6 +74,26 @@ def estimate_rotations(
         )
     if len(times) != n:  # a frame's worth of slack for containers that list one extra
         times = times[:n] if len(times) > n else np.arange(n) / max(info.fps, 1.0)
+    samples = None
+    if kept:
+        samples = Samples(*(np.concatenate(parts) for parts in zip(*kept, strict=True)))
+    return replace(_track(times, found, bands), samples=samples)
+
+
+def estimate_again(estimator: HoughEstimator, track: VisualTrack, bands: int = 0) -> VisualTrack:
+    """A track's rotations estimated again from its kept samples by another
+    ``estimator`` (of the same grid: another focal length), bands too, without decoding
+    anything."""
+    samples = track.samples
+    found: list[list[tuple]] = [[] for _ in range(bands + 1)]
+    masks = band_masks(estimator, estimator.size[0], bands)
+    for first in range(0, len(samples.u), ESTIMATE_CHUNK):
+        part = slice(first, first + ESTIMATE_CHUNK)
+        _vote(estimator, samples.u[part], samples.v[part], samples.valid[part], masks, found)
+    return replace(_track(track.times, found, bands), samples=samples)
+
+
+def _track(times: NDArray, found: list[list[tuple]], bands: int) -> VisualTrack:
     R, support, rows = (np.array([item[i] for item in found[0]]) for i in range(3))
     if not bands:
         return VisualTrack(times, R, support, rows)
@@ -91,31 +120,39 @@ def _estimator_and_frames(
     return estimator, (cv2.remap(f, *maps, cv2.INTER_LINEAR) for f in frames)
 
 
-def _vote(
-    estimator: HoughEstimator, flows: Iterator[NDArray], height: int, bands: int, progress: Progress
-) -> list[list[tuple]]:
-    """(R, support, mean row) per pair: from the whole frame, then from each band."""
-    sample_rows = estimator.grid.rows
+def band_masks(estimator: HoughEstimator, height: int, bands: int) -> list[NDArray]:
+    """Which sample vectors vote for the whole frame (all of them), then for each of
+    ``bands`` horizontal bands (those whose row lies in it)."""
+    grid = estimator.grid
+    rows = np.repeat(grid.rows, len(grid.cols))
     edges = np.linspace(0, height, bands + 1).round().astype(int)
-    found: list[list[tuple]] = [[] for _ in range(bands + 1)]  # whole frame, then bands
+    masks = [np.ones(len(rows), bool)]
+    return masks + [(rows >= edges[b - 1]) & (rows < edges[b]) for b in range(1, bands + 1)]
+
+
+def _sampled(estimator: HoughEstimator, flows: Iterator[NDArray]) -> Iterator[tuple]:
+    """(u, v, valid) of ``ESTIMATE_CHUNK`` flow fields at a time."""
     chunk: list[NDArray] = []
-
-    def flush() -> None:
-        stacked = np.stack(chunk)
-        for b in range(bands + 1):
-            if b:  # only this band's vectors vote
-                stacked = np.stack(chunk)
-                stacked[:, : edges[b - 1]] = np.nan
-                stacked[:, edges[b] :] = np.nan
-            for est in estimator.estimate_many(stacked):
-                found[b].append((est.matrix, est.support, mean_row(est, sample_rows, height)))
-        progress(len(chunk))
-        chunk.clear()
-
     for f in flows:
         chunk.append(f)
         if len(chunk) == ESTIMATE_CHUNK:
-            flush()
+            yield estimator.samples(np.stack(chunk))
+            chunk.clear()
     if chunk:
-        flush()
-    return found
+        yield estimator.samples(np.stack(chunk))
+
+
+def _vote(
+    estimator: HoughEstimator,
+    u: NDArray,
+    v: NDArray,
+    valid: NDArray,
+    masks: list[NDArray],
+    found: list[list[tuple]],
+) -> None:
+    """(R, support, mean row) of each pair into ``found``: whole frame, then each band."""
+    sample_rows = estimator.grid.rows
+    height = estimator.size[0]
+    for b, mask in enumerate(masks):
+        for est in estimator.estimate_samples(u, v, valid & mask):
+            found[b].append((est.matrix, est.support, mean_row(est, sample_rows, height)))

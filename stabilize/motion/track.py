@@ -19,6 +19,21 @@ from rotation import RotationEstimate
 
 
 @dataclass(frozen=True)
+class Samples:
+    """The flow vectors pass 1 read at the estimator's sample grid, kept (float32, about
+    5 KB a pair) so that the rotations can be estimated again without decoding: with
+    another focal length (:mod:`stabilize.motion.focal`)."""
+
+    u: NDArray[np.float32]  # (N-1, M)
+    v: NDArray[np.float32]
+    valid: NDArray[np.bool_]
+
+    def pairs(self, first: int, stop: int) -> Samples:
+        """The pairs first..stop-1."""
+        return Samples(self.u[first:stop], self.v[first:stop], self.valid[first:stop])
+
+
+@dataclass(frozen=True)
 class VisualTrack:
     times: NDArray[np.float64]  # (N,) s, video clock: when each frame's first row is captured
     rotations: NDArray[np.float64]  # (N-1, 3, 3) R_t
@@ -27,6 +42,7 @@ class VisualTrack:
     bands: NDArray[np.float64] | None = None  # (B, N-1, 3, 3) R_t from each band alone
     band_rows: NDArray[np.float64] | None = None  # (B, N-1) their mean heights
     band_support: NDArray[np.float64] | None = None  # (B, N-1)
+    samples: Samples | None = None  # the flow vectors read, where kept
 
     @classmethod
     def from_rotations(cls, times: NDArray, rotations: NDArray) -> VisualTrack:
@@ -46,6 +62,7 @@ class VisualTrack:
             cut(self.bands),
             cut(self.band_rows),
             cut(self.band_support),
+            None if self.samples is None else self.samples.pairs(first, stop),
         )
 
 

@@ -48,6 +48,7 @@ class VideoInfo:
     streams: tuple[Stream, ...] = ()
     start: float = 0.0  # the container's start time, s: its earliest stream's first timestamp
     chapters: int = 0
+    metadata: str = ""  # the file's own tags as FFmpeg lists them (before its streams)
 
     @property
     def size(self) -> tuple[int, int]:
@@ -155,4 +156,5 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
         streams,
         float(start.group(1)) if start else 0.0,
         len(re.findall(r"^\s+Chapter #", text, re.M)),
+        text[: text.find("Stream #")],
     )

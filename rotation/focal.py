@@ -1,0 +1,171 @@
+"""The focal length from rotational flow alone.
+
+A camera turning by ω moves a pixel p = (x, y) (relative to the principal point) by
+
+    u ≈ -ωx·xy/f + ωy·(f + x²/f) - ωz·y,      v ≈ -ωx·(f + y²/f) + ωy·xy/f + ωz·x,
+
+so f shows in the quadratic terms at the frame's edges: with a wrong f no rotation
+explains both the middle and the edges, and the best fit leaves a residual that grows
+with the turn, ∝ ω·(1/f - 1/f_true).
+
+Walking forward over a ground plane leaves a residual of the same shape (its flow is
+x·y·T/(f h) and y²·T/(f h)), which would bias f. But the two differ in time: a hand's
+shake turns the camera back and forth from frame to frame, while the walk's flow is
+the same from one frame to the next. So each pair's residual field d_t(i) is compared
+with its own running mean over ±``WINDOW`` pairs (the slow, translation part), and only
+what changes from frame to frame is scored:
+
+    C(f) = Σ_t Σ_i min(|d_t(i) - d̄_t(i)|², c²),      c = ``CLIP_PX``,
+
+each pair's rotation fitted again at f (Gauss-Newton from the estimate made at f₀, its
+pitch and yaw scaled by f₀/f). The truncation keeps moving people and bad flow from
+steering the fit. The minimum over a coarse log grid of f, then a fine one, refined by a
+parabola, is the estimate; a curve without a clear interior minimum (a tripod, pure
+roll, too little motion) gives none.
+"""
+
+from __future__ import annotations
+
+import math
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+from numba import get_num_threads, njit
+from numpy.typing import NDArray
+
+from rotation.refine import refine, rodrigues, rotate_ray
+
+CLIP_PX = 1.5  # residuals beyond this many pixels count as outliers, at a fixed cost
+GATE_PX = 3.0  # the first robust scale of each refit
+WINDOW = 15  # pairs on each side of the running median that holds the walk's parallax
+STRIDE = 5  # pairs between the running median's evaluations
+MIN_DEPTH = 0.01  # the curve must rise this share above its minimum somewhere
+COARSE = 25  # candidates over the whole range, log-spaced (about 13% apart at 10–150°)
+FINE = 9  # candidates between the coarse minimum's neighbours
+
+
+@dataclass(frozen=True)
+class FocalEstimate:
+    """The focal length that best explains the pairs' flow, in pixels at the flow's size,
+    or None where the flow does not pin it down; with the cost curve it came from."""
+
+    focal: float | None
+    focals: NDArray[np.float64]
+    costs: NDArray[np.float64]
+    pairs: int
+
+    @property
+    def depth(self) -> float:
+        """How far the curve rises above its minimum, as a share of its highest point."""
+        top = float(self.costs.max()) if len(self.costs) else 0.0
+        return float(1.0 - self.costs.min() / top) if top > 0 else 0.0
+
+
+@njit(cache=True, nogil=True)
+def residual_fields(x, y, U, V, VALID, W0, f0, f) -> np.ndarray:
+    """d_t(i) = q_t(i) - π(R_t (x_i, y_i, f)) for every pair (P, M, 2), each R_t refitted
+    at f from the rotation vector W0[t] found at f0."""
+    P, M = U.shape
+    out = np.zeros((P, M, 2))
+    for p in range(P):
+        w = np.array([W0[p, 0] * f0 / f, W0[p, 1] * f0 / f, W0[p, 2]])
+        R = refine(x, y, x + U[p], y + V[p], f, rodrigues(w), VALID[p], GATE_PX)
+        for i in range(M):
+            X0, X1, X2 = rotate_ray(R, x[i], y[i], f)
+            if VALID[p, i] and X2 > 1e-9:
+                out[p, i, 0] = x[i] + U[p, i] - f * X0 / X2
+                out[p, i, 1] = y[i] + V[p, i] - f * X1 / X2
+    return out
+
+
+def cost(x, y, u, v, valid, rotvecs, f0: float, f: float) -> float:
+    """C(f) of the module docstring."""
+    d = residual_fields(x, y, u, v, valid, rotvecs, f0, f)
+    r2 = np.sum((d - running_median(d, valid)) ** 2, axis=-1)
+    return float(np.sum(np.minimum(r2, CLIP_PX**2) * valid))
+
+
+def running_median(d: NDArray, valid: NDArray) -> NDArray[np.float64]:
+    """Per sample position, the median of its residual over ±WINDOW pairs (valid ones
+    only): the walk's slow parallax, untouched by an outlier here and there."""
+    return _running_median(d, valid, WINDOW)
+
+
+@njit(cache=True, nogil=True)
+def _running_median(d, valid, window) -> np.ndarray:
+    """The windowed median at every ``STRIDE``-th pair, held for the pairs around it:
+    the parallax changes slowly, and a median at every pair would cost 5× as much."""
+    P, M, _ = d.shape
+    out = np.zeros_like(d)
+    buf = np.empty(2 * window + 1)
+    for centre in range(STRIDE // 2, P + STRIDE // 2, STRIDE):
+        p = min(centre, P - 1)
+        lo, hi = max(0, p - window), min(P, p + window + 1)
+        first, last = max(0, centre - STRIDE // 2), min(P, centre - STRIDE // 2 + STRIDE)
+        for i in range(M):
+            for c in range(2):
+                n = 0
+                for q in range(lo, hi):
+                    if valid[q, i]:
+                        buf[n] = d[q, i, c]
+                        n += 1
+                if n:
+                    value = np.median(buf[:n])
+                    for t in range(first, last):
+                        out[t, i, c] = value
+    return out
+
+
+def estimate_focal(
+    x: NDArray,
+    y: NDArray,
+    u: NDArray,
+    v: NDArray,
+    valid: NDArray,
+    rotvecs: NDArray,
+    f0: float,
+    bounds: tuple[float, float],
+) -> FocalEstimate:
+    """The focal length (px) best explaining consecutive sampled pairs: positions ``x``,
+    ``y`` (M,) relative to the principal point, flows ``u``, ``v`` (P, M) and their
+    validity, the rotation vectors found at ``f0`` (P, 3), searched within ``bounds``."""
+    args = (
+        np.asarray(x, np.float64),
+        np.asarray(y, np.float64),
+        np.ascontiguousarray(u, np.float64),
+        np.ascontiguousarray(v, np.float64),
+        np.ascontiguousarray(valid, np.bool_),
+        np.ascontiguousarray(rotvecs, np.float64),
+        float(f0),
+    )
+    coarse = np.exp(np.linspace(math.log(bounds[0]), math.log(bounds[1]), COARSE))
+    coarse_costs = _costs(args, coarse)
+    k = int(np.argmin(coarse_costs))
+    curve = FocalEstimate(None, coarse, coarse_costs, len(u))
+    if len(u) < 3 or k in (0, COARSE - 1) or curve.depth < MIN_DEPTH:
+        return curve
+    fine = np.exp(np.linspace(math.log(coarse[k - 1]), math.log(coarse[k + 1]), FINE))
+    fine_costs = _costs(args, fine)
+    j = int(np.clip(np.argmin(fine_costs), 1, FINE - 2))
+    best = _vertex(np.log(fine[j - 1 : j + 2]), fine_costs[j - 1 : j + 2])
+    focals = np.concatenate([coarse, fine])
+    order = np.argsort(focals)
+    costs = np.concatenate([coarse_costs, fine_costs])[order]
+    return FocalEstimate(best, focals[order], costs, len(u))
+
+
+def _costs(args: tuple, focals: NDArray) -> NDArray[np.float64]:
+    """C(f) for each candidate, on every core (the kernel releases the GIL)."""
+    with ThreadPoolExecutor(max(1, get_num_threads())) as pool:
+        return np.array(list(pool.map(lambda f: cost(*args, f), focals)))
+
+
+def _vertex(t: NDArray, c: NDArray) -> float:
+    """exp of the vertex of the parabola through three (log f, cost) points."""
+    (t0, t1, t2), (c0, c1, c2) = t, c
+    denom = (t0 - t1) * (t0 - t2) * (t1 - t2)
+    a = (t2 * (c1 - c0) + t1 * (c0 - c2) + t0 * (c2 - c1)) / denom
+    b = (t2 * t2 * (c0 - c1) + t1 * t1 * (c2 - c0) + t0 * t0 * (c1 - c2)) / denom
+    vertex = -b / (2 * a) if a > 0 else t1
+    return float(math.exp(min(max(vertex, t0), t2)))

@@ -1,0 +1,189 @@
+"""The camera's focal length: given, from a lens profile, from the file's metadata, or
+estimated from the clip's own flow (:mod:`rotation.focal`), in that order of trust.
+
+A wrong focal length is not harmless: rotational flow carries x²/f and xy/f terms at the
+frame's edges, so a wrong f leaves keystone wobble there and mixes the axes. With no
+``--fov``, ``--focal`` or ``--lens``, pass 1 runs at the metadata's focal length (or the
+69° default), the focal length is estimated from the flow vectors it kept, and every
+rotation is estimated again at it, without decoding the clip a second time. A clip that
+does not pin f down (a tripod, pure roll, too little motion) keeps the starting value,
+and says so.
+
+Phones write a 35 mm-equivalent focal length F (QuickTime's
+``com.apple.quicktime.camera.focal_length.35mm_equivalent``, EXIF's
+``FocalLengthIn35mmFilm``), defined on the 43.27 mm diagonal of a 36×24 mm frame:
+
+    f_px = F · √(W² + H²) / 43.27.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+import flow
+from rotation import HoughEstimator, so3
+from rotation.camera import fov_from_focal
+from rotation.focal import estimate_focal
+from stabilize.motion.estimate import estimate_again, estimate_rotations
+from stabilize.motion.track import VisualTrack
+from stabilize.progress import Progress, no_progress
+from stabilize.settings import Settings
+from stabilize.video import VideoInfo
+from stabilize.warp.lens import Lens
+
+FULL_FRAME_DIAGONAL_MM = 43.27
+FOV_BOUNDS = (15.0, 150.0)  # the fields of view searched, degrees across
+MAX_PAIRS = 120  # consecutive pairs the estimate is made on (the most-turning stretch)
+MIN_TURN_DEG = 0.05  # median pitch/yaw per pair below which f is not pinned down
+DISAGREES = 0.15  # an estimate this far from the metadata's is reported
+
+_METADATA = re.compile(
+    r"(?:focal_length\.35mm_equivalent|FocalLengthIn35mmFilm|focal_length_35mm)\s*:\s*([\d.]+)"
+)
+
+
+@dataclass(frozen=True)
+class FocalChoice:
+    """The focal length used, in pixels at the video's size, and where it came from:
+    ``given``, ``lens``, ``metadata``, ``estimated`` or ``default``."""
+
+    px: float
+    width: int
+    source: str
+    estimated_px: float | None = None
+    metadata_px: float | None = None
+    note: str = ""
+
+    @property
+    def fov_deg(self) -> float:
+        return fov_from_focal(self.px, self.width)
+
+    def summary(self) -> dict:
+        return {
+            "px": self.px,
+            "fov_deg": self.fov_deg,
+            "source": self.source,
+            "estimated_px": self.estimated_px,
+            "metadata_px": self.metadata_px,
+            "note": self.note,
+        }
+
+
+def metadata_focal(info: VideoInfo) -> float | None:
+    """The focal length (px) the file's metadata gives as a 35 mm equivalent, if any:
+    a video's QuickTime keys, or the EXIF of an image sequence's first image."""
+    h, w = info.size
+    equivalent = _tag_35mm(info.metadata) if info.metadata else None
+    if equivalent is None and info.input_args:
+        equivalent = _exif_35mm(info)
+    if not equivalent:
+        return None
+    return equivalent * math.hypot(w, h) / FULL_FRAME_DIAGONAL_MM
+
+
+def _tag_35mm(text: str) -> float | None:
+    found = _METADATA.search(text)
+    return float(found.group(1)) if found else None
+
+
+def _exif_35mm(info: VideoInfo) -> float | None:
+    """FocalLengthIn35mmFilm (tag 41989) of the first image of a %d pattern."""
+    args = dict(zip(info.input_args[::2], info.input_args[1::2], strict=False))
+    first = Path(str(info.path) % int(args.get("-start_number", 1)))
+    try:
+        from PIL import Image
+
+        with Image.open(first) as image:
+            value = image.getexif().get_ifd(0x8769).get(41989)
+    except (OSError, ValueError, ImportError):
+        return None
+    return float(value) if value else None
+
+
+def initial_focal(settings: Settings, info: VideoInfo, lens: Lens | None) -> FocalChoice:
+    """The focal length pass 1 starts from: given, the lens's, the metadata's, or the
+    default; with ``fov="auto"`` the last two are where the estimate starts."""
+    width = info.width
+    meta = metadata_focal(info)
+    if settings.fov_given:
+        return FocalChoice(settings.focal_px(width), width, "given", metadata_px=meta)
+    if lens is not None:
+        return FocalChoice(float(lens.K[0, 0]), width, "lens", metadata_px=meta)
+    if meta is not None:
+        return FocalChoice(meta, width, "metadata", metadata_px=meta)
+    return FocalChoice(settings.focal_px(width), width, "default")
+
+
+def estimate_motion(
+    path: str | Path,
+    info: VideoInfo,
+    settings: Settings,
+    progress: Progress = no_progress,
+    times: NDArray | None = None,
+    *,
+    bands: int = 0,
+    lens: Lens | None = None,
+) -> tuple[VisualTrack, FocalChoice]:
+    """Pass 1 with the focal length resolved: the track, and the focal length it was
+    estimated at (:class:`FocalChoice`)."""
+    choice = initial_focal(settings, info, lens)
+    auto = settings.fov == "auto" and choice.source in ("metadata", "default")
+    at_start = replace(settings, focal=choice.px, fov=None)
+    track = estimate_rotations(
+        path, info, at_start, progress, times, bands=bands, lens=lens, keep_samples=auto
+    )
+    if not auto:
+        return track, choice
+    ws = flow.working_size(info.size)
+    start = HoughEstimator(ws.size, choice.px * ws.scale[0])
+    found = focal_from_track(track, start, info.width * ws.scale[0])
+    if found is None:
+        note = f"the clip's motion does not pin the focal length down: {choice.source} kept"
+        return replace(track, samples=None), replace(choice, note=note)
+    estimator = HoughEstimator(ws.size, found, max_deg=settings.max_deg)
+    again = estimate_again(estimator, track, bands)
+    px = found / ws.scale[0]
+    note = ""
+    if choice.metadata_px and abs(px / choice.metadata_px - 1) > DISAGREES:
+        note = f"the estimate is {100 * (px / choice.metadata_px - 1):+.0f}% off the metadata's"
+    estimated = FocalChoice(px, info.width, "estimated", px, choice.metadata_px, note)
+    return replace(again, samples=None), estimated
+
+
+def focal_from_track(track: VisualTrack, estimator: HoughEstimator, width: float) -> float | None:
+    """The focal length (px at the flow's size) from a track's kept samples, estimated at
+    ``estimator``'s focal length; None where the motion does not pin it down."""
+    samples = track.samples
+    rotvecs = so3.log_so3(track.rotations)
+    turn = np.degrees(np.hypot(rotvecs[:, 0], rotvecs[:, 1]))
+    if samples is None or len(turn) < 3 or np.median(turn) < MIN_TURN_DEG:
+        return None
+    first = _most_turning(turn, MAX_PAIRS)
+    part = slice(first, first + MAX_PAIRS)
+    bounds = tuple(width / 2 / math.tan(math.radians(a) / 2) for a in FOV_BOUNDS[::-1])
+    grid = estimator.grid
+    found = estimate_focal(
+        grid.x,
+        grid.y,
+        samples.u[part],
+        samples.v[part],
+        samples.valid[part],
+        rotvecs[part],
+        estimator.focal,
+        bounds,
+    )
+    return found.focal
+
+
+def _most_turning(turn: NDArray, n: int) -> int:
+    """The first pair of the n consecutive pairs that turn the most, in pitch and yaw."""
+    if len(turn) <= n:
+        return 0
+    window = np.convolve(turn, np.ones(n), mode="valid")
+    return int(np.argmax(window))

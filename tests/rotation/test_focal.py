@@ -1,0 +1,48 @@
+"""The focal length from rotational flow, with known answers."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rotation import HoughEstimator
+from rotation.camera import focal_from_fov
+from rotation.focal import estimate_focal
+from rotation.synthetic import make_set
+
+SIZE = (270, 480)
+BOUNDS = (focal_from_fov(150, 480), focal_from_fov(15, 480))
+
+
+def estimate(name: str, fov: float, n: int = 90):
+    truth = focal_from_fov(fov, SIZE[1])
+    data = make_set(name, n, seed=2, focal=truth, max_deg=1.0)
+    start = focal_from_fov(69.0, SIZE[1])
+    est = HoughEstimator(SIZE, start, max_deg=15)
+    u, v, valid = est.samples(data.flows)
+    rotvecs = np.array([r.rotvec for r in est.estimate_samples(u, v, valid)])
+    return truth, estimate_focal(est.grid.x, est.grid.y, u, v, valid, rotvecs, start, BOUNDS)
+
+
+@pytest.mark.parametrize("fov", [30.0, 100.0])
+def test_the_focal_length_of_pure_rotation_is_recovered(fov):
+    truth, found = estimate("pure", fov)
+    assert found.focal == pytest.approx(truth, rel=0.005)
+
+
+@pytest.mark.parametrize("fov", [45.0, 100.0])
+def test_a_walk_past_walls_and_people_does_not_steer_it(fov):
+    truth, found = estimate("street", fov)
+    assert found.focal == pytest.approx(truth, rel=0.03)
+
+
+def test_no_motion_pins_nothing_down():
+    start = focal_from_fov(69.0, SIZE[1])
+    est = HoughEstimator(SIZE, start)
+    zeros = np.zeros((40, len(est.grid.x)))
+    found = estimate_focal(
+        est.grid.x, est.grid.y, zeros, zeros, zeros == 0, np.zeros((40, 3)), start, BOUNDS
+    )
+    assert found.focal is None and math.isclose(found.depth, 0.0, abs_tol=1e-9)

@@ -1,0 +1,49 @@
+"""Where the focal length comes from: given, metadata, estimated, default."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from stabilize import Settings
+from stabilize.motion.focal import FULL_FRAME_DIAGONAL_MM, estimate_motion, initial_focal
+from stabilize.video import ffmpeg_exe, probe
+
+
+def tagged(shaky: Path, folder: Path, mm: float) -> Path:
+    """The clip with a phone's QuickTime 35 mm-equivalent focal-length key."""
+    out = folder / "tagged.mov"
+    key = f"com.apple.quicktime.camera.focal_length.35mm_equivalent={mm}"
+    cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(shaky), "-c", "copy"]
+    subprocess.run([*cmd, "-metadata", key, "-movflags", "use_metadata_tags", str(out)], check=True)
+    return out
+
+
+def test_the_metadata_focal_length_is_read(shaky, tmp_path):
+    info = probe(tagged(shaky, tmp_path, 26.0))
+    choice = initial_focal(Settings(), info, None)
+    assert choice.source == "metadata"
+    assert choice.px == pytest.approx(26.0 * (320**2 + 180**2) ** 0.5 / FULL_FRAME_DIAGONAL_MM)
+    assert initial_focal(Settings(fov=50.0), info, None).source == "given"
+    assert initial_focal(Settings(), probe(shaky), None).source == "default"
+
+
+def test_auto_moves_a_wrong_start_towards_the_truth(tmp_path):
+    # A 40° clip started from the 69° default (47% off). The estimate is not yet within
+    # the 3% that issue #15 asks (walking parallax biases it long, +14% here), but it
+    # must land far closer than where it started.
+    from stabilize.synth import SynthOptions, render_clip
+
+    options = SynthOptions(size=(180, 320), seconds=2.0, seed=11, shake_deg=1.5, crowd=4)
+    render_clip(tmp_path, replace(options, hfov=40.0))
+    truth = 160.0 / math.tan(math.radians(20.0))
+    clip = tmp_path / "clip.mp4"
+    track, focal = estimate_motion(clip, probe(clip), Settings(fov="auto"))
+    start = Settings().focal_px(320)
+    assert focal.source == "estimated" and track.samples is None
+    assert abs(focal.px / truth - 1) < abs(start / truth - 1) / 3
+    assert focal.summary()["fov_deg"] == pytest.approx(focal.fov_deg)
