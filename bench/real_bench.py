@@ -1,0 +1,94 @@
+"""Real footage: ours against FFmpeg's vid.stab on every real clip in ../shared/data, and
+on rendered walks at fields of view the tool is not told.
+
+Each clip is stabilised by both tools with the same encoder (libx264, CRF 18, preset
+medium; see ``stabilize_bench.py``), and the table gives, for the original and for each
+output, the residual shake (``stabilize evaluate``: the RMS of the high-passed
+frame-to-frame similarity motion, px at the clip's width), stability, cropping,
+distortion and wall time, then the median of ours ÷ vid.stab's residual shake.
+
+    python bench/real_bench.py                 # the real clips and three rendered walks
+    python bench/real_bench.py --fov auto      # our run with the focal length estimated
+    python bench/real_bench.py clip.mp4 ...    # other clips
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from stabilize_bench import timed, vidstab
+
+from stabilize.evaluate.metrics import evaluate_pair
+from stabilize.video import ffmpeg_exe, probe, read_frames
+
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
+REAL = ("handheld/cockatoo.mp4", "gopro/karma.mp4", "gopro/hero7.mp4", "gopro/max-heromode.mp4")
+RENDERED_FOV = (30.0, 45.0, 100.0)  # walks past near walls, at these unknown fields of view
+
+
+def clips(work: Path) -> list[Path]:
+    """The real clips, phone-cc9's frames as a clip, and the rendered walks."""
+    found = [SHARED / name for name in REAL if (SHARED / name).is_file()]
+    frames = SHARED / "phone-cc9" / "frames"
+    if frames.is_dir():
+        cc9 = work / "phone-cc9.mp4"
+        pattern = ["-framerate", "30", "-start_number", "99", "-i", str(frames / "RE_frame-%d.jpg")]
+        cmd = [ffmpeg_exe(), "-v", "error", "-y", *pattern, "-c:v", "libx264", "-crf", "12"]
+        subprocess.run([*cmd, "-pix_fmt", "yuv420p", str(cc9)], check=True)
+        found.append(cc9)
+    from stabilize.synth import SynthOptions, render_clip
+
+    for fov in RENDERED_FOV:
+        folder = work / f"walk{int(fov)}"
+        render_clip(folder, SynthOptions(seed=int(fov), seconds=4.0, hfov=fov, walk=1.4))
+        found.append(folder / "clip.mp4")
+    return found
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("clips", nargs="*", type=Path)
+    parser.add_argument("--fov", help="passed to our run (e.g. auto)")
+    args = parser.parse_args()
+    work = Path(tempfile.mkdtemp(prefix="real-bench-"))
+    ratios = []
+    header = (
+        f"{'clip':28s}{'tool':10s}{'shake px':>9s}{'stab':>7s}{'crop':>7s}{'dist':>7s}{'s':>7s}"
+    )
+    print(header)
+    for clip in args.clips or clips(work):
+        info = probe(clip)
+        name = f"{clip.parent.name}/{clip.name}"[-27:]
+        mine, theirs = work / f"{clip.stem}_ours.mp4", work / f"{clip.stem}_vidstab.mp4"
+        cmd = [sys.executable, "-m", "stabilize.cli", "run", str(clip), str(mine), "-q"]
+        t_ours, _ = timed([*cmd, "--overwrite", *(["--fov", args.fov] if args.fov else [])])
+        t_vs, _ = vidstab(clip, theirs, work)
+        fps = info.fps or 30.0
+        original, ours_m = evaluate_pair(read_frames(clip), read_frames(mine, info.size), fps)
+        _, theirs_m = evaluate_pair(read_frames(clip), read_frames(theirs, info.size), fps)
+        for tool, m, t in (("original", original, None), ("ours", ours_m, t_ours)):
+            print(_row(name, tool, m, t))
+        print(_row(name, "vid.stab", theirs_m, t_vs))
+        ratios.append(ours_m.residual_shake_px / theirs_m.residual_shake_px)
+    print(
+        f"\nours ÷ vid.stab residual shake: median {statistics.median(ratios):.2f} "
+        f"({', '.join(f'{r:.2f}' for r in ratios)}); outputs in {work}"
+    )
+
+
+def _row(clip: str, tool: str, m, seconds: float | None) -> str:
+    t = f"{seconds:7.1f}" if seconds is not None else f"{'':7s}"
+    return (
+        f"{clip:28s}{tool:10s}{m.residual_shake_px:9.3f}{m.stability:7.3f}"
+        f"{m.cropping_ratio:7.3f}{m.distortion:7.3f}{t}"
+    )
+
+
+if __name__ == "__main__":
+    main()
