@@ -30,7 +30,7 @@ class Settings:
 
     flow: str = "dis"  # flow backend (flow.BACKENDS)
     flow_options: dict = field(default_factory=dict)
-    fov: float | str | None = None  # horizontal field of view, degrees; "auto": estimated
+    fov: float | str | None = None  # horizontal field of view, degrees; None or "auto": estimated
     focal: float | None = None  # pixels; overrides fov
     smooth: float = 0.5  # smoothing time constant, s
     method: str = "adaptive"  # smoothing method (stabilize.path.smoothing.METHODS)

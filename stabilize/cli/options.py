@@ -36,9 +36,10 @@ DeviceOption = Annotated[
 FovOption = Annotated[
     str | None,
     typer.Option(
-        help="Horizontal field of view, degrees (1–179), or 'auto': estimated from the "
-        "clip's own motion. Default: the file's metadata (a phone's 35 mm equivalent), "
-        "else 69° (a phone's main camera).",
+        help="Horizontal field of view, degrees (1–179). Default (auto): estimated from "
+        "the clip's own motion, starting from the file's metadata (a phone's 35 mm "
+        "equivalent) or 69° (a phone's main camera), which stay where the motion does "
+        "not pin it down.",
     ),
 ]
 FocalOption = Annotated[

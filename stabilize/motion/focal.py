@@ -3,11 +3,12 @@ estimated from the clip's own flow (:mod:`rotation.focal`), in that order of tru
 
 A wrong focal length is not harmless: rotational flow carries x²/f and xy/f terms at the
 frame's edges, so a wrong f leaves keystone wobble there and mixes the axes. With no
-``--fov``, ``--focal`` or ``--lens``, pass 1 runs at the metadata's focal length (or the
-69° default), the focal length is estimated from the flow vectors it kept, and every
-rotation is estimated again at it, without decoding the clip a second time. A clip that
-does not pin f down (a tripod, pure roll, too little motion) keeps the starting value,
-and says so.
+``--fov``, ``--focal`` or ``--lens`` (``--fov auto``), pass 1 runs at the metadata's focal
+length (or the 69° default), the focal length is estimated from the flow vectors it kept,
+and every rotation is estimated again at it, without decoding the clip a second time. An
+estimate within 15% of the metadata's keeps the metadata's (the finer figure); a clip
+that does not pin f down (a tripod, pure roll, too little motion) keeps the starting
+value, and says so.
 
 Phones write a 35 mm-equivalent focal length F (QuickTime's
 ``com.apple.quicktime.camera.focal_length.35mm_equivalent``, EXIF's
@@ -108,7 +109,7 @@ def _exif_35mm(info: VideoInfo) -> float | None:
 
 def initial_focal(settings: Settings, info: VideoInfo, lens: Lens | None) -> FocalChoice:
     """The focal length pass 1 starts from: given, the lens's, the metadata's, or the
-    default; with ``fov="auto"`` the last two are where the estimate starts."""
+    default; the last two are where the estimate starts (:func:`estimate_motion`)."""
     width = info.width
     meta = metadata_focal(info)
     if settings.fov_given:
@@ -133,7 +134,7 @@ def estimate_motion(
     """Pass 1 with the focal length resolved: the track, and the focal length it was
     estimated at (:class:`FocalChoice`)."""
     choice = initial_focal(settings, info, lens)
-    auto = settings.fov == "auto" and choice.source in ("metadata", "default")
+    auto = choice.source in ("metadata", "default")  # nothing given: estimated
     at_start = replace(settings, focal=choice.px, fov=None)
     track = estimate_rotations(
         path, info, at_start, progress, times, bands=bands, lens=lens, keep_samples=auto
@@ -146,14 +147,14 @@ def estimate_motion(
     if found is None:
         note = f"the clip's motion does not pin the focal length down: {choice.source} kept"
         return replace(track, samples=None), replace(choice, note=note)
+    px = found / ws.scale[0]
+    meta = choice.metadata_px
+    if meta and abs(px / meta - 1) <= DISAGREES:  # agreed: the lens's own figure is finer
+        return replace(track, samples=None), replace(choice, estimated_px=px)
+    note = f"{100 * (px / meta - 1):+.0f}% off the metadata's (a digital zoom?)" if meta else ""
     estimator = HoughEstimator(ws.size, found, max_deg=settings.max_deg)
     again = estimate_again(estimator, track, bands)
-    px = found / ws.scale[0]
-    note = ""
-    if choice.metadata_px and abs(px / choice.metadata_px - 1) > DISAGREES:
-        note = f"the estimate is {100 * (px / choice.metadata_px - 1):+.0f}% off the metadata's"
-    estimated = FocalChoice(px, info.width, "estimated", px, choice.metadata_px, note)
-    return replace(again, samples=None), estimated
+    return replace(again, samples=None), FocalChoice(px, info.width, "estimated", px, meta, note)
 
 
 def focal_from_track(track: VisualTrack, estimator: HoughEstimator, width: float) -> float | None:
