@@ -160,7 +160,7 @@ def compiling_notice() -> tuple[str, ...]:
 
     if kernels_cached():
         return ()
-    return (f"compiling the estimator's kernels: about 15 s, once (cached in {cache_dir()})",)
+    return (f"compiling the estimator's kernels: about 20 s, once (cached in {cache_dir()})",)
 
 
 def _rotations(settings: Settings, job: Job, track: VisualTrack) -> tuple:
