@@ -36,6 +36,7 @@ class Container:
     chapters: bool = True
     options: tuple[str, ...] = ()
     hevc_tag: str | None = None  # the codec tag Apple players need for HEVC
+    data: frozenset[str] = frozenset()  # data tracks held as they are, by codec tag
 
     def audio_codec(self, codec: str) -> str:
         """``copy`` for an audio codec held as it is, else the encoder it becomes."""
@@ -55,6 +56,7 @@ MP4 = Container(
     subtitle_encoder="mov_text",
     options=QUICKTIME,
     hevc_tag="hvc1",
+    data=frozenset({"gpmd"}),  # GoPro's GPMF telemetry (its gyro): telemetry-parser reads it back
 )
 
 # The registry: an output suffix → its container. Adding one is a line here.

@@ -1,5 +1,6 @@
 """Keeping what the user gave us: every audio and subtitle track of the source, its
-chapters and its metadata, muxed beside the stabilised video.
+chapters and its metadata, and the data tracks the container can hold (GoPro's GPMF
+telemetry in MP4 and MOV), muxed beside the stabilised video.
 
 Each track is copied when the output container holds it as it is, transcoded when it
 does not (AAC into WebM becomes Opus, mov_text into MKV becomes SRT), and left out only
@@ -15,8 +16,6 @@ from stabilize.video.containers import Container
 from stabilize.video.encode import Mux
 from stabilize.video.probe import Stream, VideoInfo
 
-KEPT = ("audio", "subtitle")  # the kinds of stream carried over from the source
-
 
 def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0) -> Mux:
     """The :class:`Mux` that carries the source's tracks, chapters and metadata over.
@@ -28,28 +27,23 @@ def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0
         return Mux()
     args: list[str] = []
     notices: list[str] = []
-    count = {"audio": 0, "subtitle": 0}
+    count = {"a": 0, "s": 0, "d": 0}
     kept: list[int] = []
     for stream in info.streams:
-        if stream.kind not in KEPT:
-            if not _rebuilt(stream, info):
-                notices.append(f"left out {stream.kind} stream #{stream.index} ({stream.codec})")
+        if _rebuilt(stream, info):
             continue
-        if stream.kind == "audio":
-            codec = container.audio_codec(stream.codec)
-        else:
-            codec = container.subtitle_codec(stream.codec)
+        codec, flag = _codec(stream, container)
         where = _name(container)
         if codec is None:
+            what = stream.codec if stream.codec != "none" else stream.tag  # e.g. GoPro's tmcd
             notices.append(
-                f"left out subtitle #{stream.index} ({stream.codec}): {where} cannot hold it"
+                f"left out {stream.kind} #{stream.index} ({what}): {where} cannot hold it"
             )
             continue
         if codec != "copy":
             notices.append(f"{stream.kind} #{stream.index}: {stream.codec} → {codec} for {where}")
-        flag = "a" if stream.kind == "audio" else "s"
-        args += ["-map", f"1:{stream.index}", f"-c:{flag}:{count[stream.kind]}", codec]
-        count[stream.kind] += 1
+        args += ["-map", f"1:{stream.index}", f"-c:{flag}:{count[flag]}", codec]
+        count[flag] += 1
         kept.append(stream.index)
     # One mapping per stream: any explicit one turns FFmpeg's per-stream default off.
     args += ["-map_metadata", "1", "-map_metadata:s:0", f"1:s:{_first_video(info)}"]
@@ -60,6 +54,17 @@ def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0
             args += [f"-metadata:s:{out}", f"title={titles[index]}"]
     args += ["-map_chapters", "1" if container.chapters else "-1"]
     return Mux((("-i", str(info.path)),), tuple(args), tuple(notices), video_delay)
+
+
+def _codec(stream: Stream, container: Container) -> tuple[str | None, str]:
+    """(``copy``, the encoder it becomes, or None: it cannot be held; FFmpeg's stream
+    letter) of a source stream in ``container``."""
+    if stream.kind == "audio":
+        return container.audio_codec(stream.codec), "a"
+    if stream.kind == "subtitle":
+        return container.subtitle_codec(stream.codec), "s"
+    held = stream.kind == "data" and stream.tag in container.data
+    return ("copy" if held else None), "d"
 
 
 def _rebuilt(stream: Stream, info: VideoInfo) -> bool:

@@ -141,3 +141,17 @@ MUXERS |= {".avi": "avi", ".ts": "mpegts", ".unknown": ""}
 @pytest.mark.parametrize(("suffix", "muxer"), list(MUXERS.items()))
 def test_the_suffix_names_the_container(suffix, muxer):
     assert container_for(f"out{suffix.upper()}").muxer == muxer
+
+
+def test_gopro_telemetry_is_kept(shared, tmp_path):
+    # GPMF, the camera's own gyro, as a data track: copied into MP4 and read back whole.
+    telemetry_parser = pytest.importorskip("telemetry_parser")
+    cut = tmp_path / "karma.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(shared / "data" / "gopro" / "karma.mp4")]
+    cmd += ["-map", "0:v", "-map", "0:a", "-map", "0:3", "-c", "copy", "-t", "2", str(cut)]
+    subprocess.run(cmd, check=True)
+    out = tmp_path / "out.mp4"
+    summary, _ = stabilize_video(cut, out, Settings(fov=100.0))
+    assert not any("gpmd" in n or "bin_data" in n for n in summary["notices"])
+    before = len(telemetry_parser.Parser(str(cut)).normalized_imu())
+    assert before > 500 and len(telemetry_parser.Parser(str(out)).normalized_imu()) == before
