@@ -4,14 +4,30 @@ Conventions (axes, flow layout, R_t) are those of CONVENTIONS.md:
 p_{t+1} ~ K R_t K⁻¹ p_t for static points at infinity.
 
 >>> from rotation import HoughEstimator, estimate, RotationEstimate
+
+The estimator (numba kernels) loads when first used, so ``rotation.so3`` and
+``rotation.camera`` stay cheap to import.
 """
+
+import importlib
 
 from rotation.cache import use_cache_dir
 
 use_cache_dir()  # before any kernel is defined: cached in the user's folder
 
-from rotation import baselines, camera, so3  # noqa: E402
-from rotation.hough import HoughEstimator, estimate  # noqa: E402
-from rotation.result import RotationEstimate  # noqa: E402
+from rotation import camera, so3  # noqa: E402
 
+_EXPORTS = {
+    "HoughEstimator": "rotation.hough",
+    "estimate": "rotation.hough",
+    "RotationEstimate": "rotation.result",
+}
 __all__ = ["HoughEstimator", "RotationEstimate", "baselines", "camera", "estimate", "so3"]
+
+
+def __getattr__(name: str):
+    if name == "baselines":
+        return importlib.import_module("rotation.baselines")
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'rotation' has no attribute {name!r}")
+    return getattr(importlib.import_module(_EXPORTS[name]), name)

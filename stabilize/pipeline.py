@@ -7,7 +7,8 @@
 2. **Path**: chain the rotations into orientations O_t, smooth them on SO(3), keep them
    within the zoom budget, and choose the zoom (:mod:`stabilize.path`).
 3. **Warp** (pass 2): decode at full resolution, warp each frame by K' C_t K⁻¹, and
-   encode, copying the audio untouched (:mod:`stabilize.warp`, :mod:`stabilize.video`).
+   encode into the container the output names, every track, chapter and tag of the
+   source kept (:mod:`stabilize.warp`, :mod:`stabilize.video`).
 """
 
 from __future__ import annotations
@@ -49,8 +50,10 @@ class Job:
     """A checked job: everything known about it before any frame is decoded."""
 
     info: VideoInfo
+    times: NDArray  # (N,) the frames' presentation times, s
     lens: Lens | None
     log: GyroLog | None
+    stamps: NDArray | None  # the frames' times on the gyro clock (--gyro-timestamps)
     mux: Mux
     notices: tuple[str, ...]
 
@@ -76,18 +79,18 @@ def stabilize_video(
     settings = settings or Settings()
     src, dst = Path(input_path), Path(output_path)
     job = prepare(src, dst, settings, overwrite)
+    tell = notify or (lambda _: None)
     for notice in (*job.notices, *compiling_notice()):
-        (notify or (lambda _: None))(notice)
+        tell(notice)
     start = time.perf_counter()
     bar = progress or (lambda label, total: no_progress)
     bands = READOUT_BANDS if settings.gyro and settings.readout_ms == "auto" else 0
-    times = frame_times(src, job.info.input_args)
-    estimating = bar("estimating", max(len(times) - 1, 0))
+    estimating = bar("estimating", max(len(job.times) - 1, 0))
     track, focal = estimate_motion(
-        src, job.info, settings, estimating, times, bands=bands, lens=job.lens
+        src, job.info, settings, estimating, job.times, bands=bands, lens=job.lens
     )
     if focal.note:
-        (notify or (lambda _: None))(f"focal length: {focal.note}")
+        tell(f"focal length: {focal.note}")
     R, rolling, repaired, gyro_summary = _rotations(settings, job, track)
     t_estimate = time.perf_counter() - start
     K = _camera_matrix(focal.px, job.info, job.lens)
@@ -136,13 +139,15 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
 
         log = load_gyro(settings)
     info = probe(src)
-    if settings.gyro_timestamps:
-        from stabilize.gyro.readers import sensor_frame_times
-
-        sensor_frame_times(settings.gyro_timestamps, 0, len(frame_times(src, info.input_args)))
     check_writable(dst)
     check_encoder(dst, settings.encoding, encoded_size(info, settings))
     lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
+    times = frame_times(src, info.input_args)  # read once: the packets, not the pixels
+    stamps = None
+    if settings.gyro_timestamps:
+        from stabilize.gyro.readers import sensor_frame_times
+
+        stamps = sensor_frame_times(settings.gyro_timestamps, 0, len(times))
     mux = keep_streams(info, container_for(dst), info.video_delay)
     notices = mux.notices
     if not settings.size and frame_size(info, settings) != info.size:
@@ -151,7 +156,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
             f"{info.width}x{info.height} has an odd side: the output is {w}x{h}, the last "
             "row or column cropped (4:2:0 video needs even sides)",
         )
-    return Job(info, lens, log, mux, notices)
+    return Job(info, times, lens, log, stamps, mux, notices)
 
 
 def compiling_notice() -> tuple[str, ...]:
@@ -169,7 +174,9 @@ def _rotations(settings: Settings, job: Job, track: VisualTrack) -> tuple:
     if job.log is not None:
         from stabilize.gyro.path import gyro_path  # gyro mode only
 
-        R, rolling, summary = gyro_path(settings, job.log, track, job.info.height, job.lens)
+        R, rolling, summary = gyro_path(
+            settings, job.log, track, job.info.height, job.lens, job.stamps
+        )
         return R, rolling, 0, summary
     R, reliable = repair_unreliable(track.rotations, track.support)
     return R, None, int((~reliable).sum()), None
@@ -196,7 +203,11 @@ def check_settings(settings: Settings) -> None:
         (settings.method in METHODS, f"--method must be one of {', '.join(METHODS)}"),
         (settings.crop in CROP_MODES, f"--crop must be one of {', '.join(CROP_MODES)}"),
         (settings.device in ("cpu", "cuda"), "--device must be cpu or cuda"),
-        (settings.fov in (None, "auto") or 0 < settings.fov < 180, "--fov must be 0–180° or auto"),
+        (
+            settings.fov in (None, "auto")
+            or (isinstance(settings.fov, int | float) and 0 < settings.fov < 180),
+            "--fov must be 0–180° or auto",
+        ),
         (settings.focal is None or settings.focal > 0, "--focal must be a positive number"),
         (settings.smooth > 0, "--smooth must be positive"),
         (settings.max_zoom >= 1.0, "--max-zoom must be at least 1"),

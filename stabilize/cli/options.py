@@ -56,9 +56,7 @@ MethodOption = Annotated[
     typer.Option(help="adaptive (follows pans), gaussian, or lock (a tripod: one orientation)."),
 ]
 LockOption = Annotated[bool, typer.Option(help="Hold one orientation, like a tripod.")]
-MaxZoomOption = Annotated[
-    float, typer.Option(min=1.0, max=4.0, help="Never zoom in more than this.")
-]
+MaxZoomOption = Annotated[float, typer.Option(min=1.0, help="Never zoom in more than this.")]
 CropOption = Annotated[
     Literal[tuple(CROP_MODES)],
     typer.Option(help="auto (one zoom), dynamic (smoothly varying), none."),

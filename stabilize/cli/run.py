@@ -95,12 +95,11 @@ def run(
     as_json: JsonOption = False,
 ) -> None:
     """Stabilise a video: estimate each frame's rotation, smooth the path, warp, encode."""
-    from stabilize.cli.bars import with_bars
-    from stabilize.pipeline import stabilize_video
-
-    settings = job_settings(ctx.params)
+    settings = job_settings(ctx.params)  # first: an option's mistake costs no import
     if report is not None:
         check_report_folder(report)
+    from stabilize.cli.bars import with_bars
+    from stabilize.pipeline import stabilize_video
 
     def job(bar):
         return stabilize_video(

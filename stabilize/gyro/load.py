@@ -5,20 +5,14 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from scipy.signal import butter, filtfilt
-
 from stabilize.gyro.log import GyroError, GyroLog
-from stabilize.gyro.readers import read_gyro, sensor_frame_times
+from stabilize.gyro.readers import read_gyro
 from stabilize.settings import Settings
 
 
-def load_gyro(settings: Settings, frames: int | None = None) -> GyroLog:
-    """The log ``settings`` name, read, checked and filtered before any work is done;
-    with ``gyro_timestamps``, that file is checked to hold the clip's ``frames`` times
-    (when the count is given)."""
+def load_gyro(settings: Settings) -> GyroLog:
+    """The log ``settings`` name, read, checked and filtered before any work is done."""
     log = read_gyro(settings.gyro, settings.gyro_format)
-    if settings.gyro_timestamps:
-        sensor_frame_times(settings.gyro_timestamps, 0, frames or 1)
     readout_seconds(settings.readout_ms, None)
     return lowpass(log, settings.gyro_lpf) if settings.gyro_lpf else log
 
@@ -28,6 +22,8 @@ def lowpass(log: GyroLog, cutoff_hz: float) -> GyroLog:
     nyquist = 0.5 * log.rate_hz
     if not 0 < cutoff_hz < nyquist:
         raise GyroError(f"--gyro-lpf must be between 0 and {nyquist:.0f} Hz, got {cutoff_hz}")
+    from scipy.signal import butter, filtfilt  # about 1 s to import: only when filtering
+
     b, a = butter(2, cutoff_hz, fs=log.rate_hz)
     return replace(log, rates=filtfilt(b, a, log.rates, axis=0))
 

@@ -11,7 +11,6 @@ from numpy.typing import NDArray
 
 from stabilize.gyro.load import readout_seconds
 from stabilize.gyro.log import GyroLog
-from stabilize.gyro.readers import sensor_frame_times
 from stabilize.gyro.rolling_shutter import frame_rotations, row_turns
 from stabilize.gyro.source import gyro_rotations
 from stabilize.gyro.sync import SyncOptions
@@ -22,14 +21,20 @@ from stabilize.warp.rolling import RollingShutter
 
 
 def gyro_path(
-    settings: Settings, log: GyroLog, track: VisualTrack, height: int, lens: Lens | None = None
+    settings: Settings,
+    log: GyroLog,
+    track: VisualTrack,
+    height: int,
+    lens: Lens | None = None,
+    stamps: NDArray | None = None,
 ) -> tuple[NDArray, RollingShutter | None, dict]:
     """(R_t, the rolling-shutter turns or None, a summary) from a gyro ``log``
-    (:func:`stabilize.gyro.load.load_gyro`), synchronised against the visual ``track``. With
-    ``gyro_timestamps`` the frames are dated on the gyro's clock by that file."""
-    if settings.gyro_timestamps:
-        stamps = sensor_frame_times(settings.gyro_timestamps, 0, len(track.times))
-        track = replace(track, times=stamps)
+    (:func:`stabilize.gyro.load.load_gyro`), synchronised against the visual ``track``.
+    With ``stamps`` (``gyro_timestamps``' frame times) the frames are dated on the
+    gyro's clock."""
+    if stamps is not None:
+        # (a container may list one frame more than decodes: the track has the decoded)
+        track = replace(track, times=np.asarray(stamps[: len(track.times)], dtype=np.float64))
     axes = None if settings.gyro_axes is None else np.array(settings.gyro_axes, dtype=float)
     readout = readout_seconds(settings.readout_ms, log.readout_s or (lens and lens.readout_s))
     options = SyncOptions(

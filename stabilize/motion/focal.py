@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 
 import flow
 from rotation import HoughEstimator, so3
-from rotation.camera import fov_from_focal
+from rotation.camera import focal_from_fov, fov_from_focal
 from rotation.focal import estimate_focal
 from stabilize.motion.estimate import estimate_again, estimate_rotations
 from stabilize.motion.track import VisualTrack
@@ -167,7 +167,7 @@ def focal_from_track(track: VisualTrack, estimator: HoughEstimator, width: float
         return None
     first = _most_turning(turn, MAX_PAIRS)
     part = slice(first, first + MAX_PAIRS)
-    bounds = tuple(width / 2 / math.tan(math.radians(a) / 2) for a in FOV_BOUNDS[::-1])
+    bounds = tuple(focal_from_fov(fov, width) for fov in FOV_BOUNDS[::-1])
     grid = estimator.grid
     found = estimate_focal(
         grid.x,

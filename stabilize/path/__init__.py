@@ -1,14 +1,22 @@
-"""The camera path: smoothing on SO(3), the zoom budget, and the choice of zoom."""
+"""The camera path: smoothing on SO(3), the zoom budget, and the choice of zoom.
 
-from stabilize.path.plan import plan_path
-from stabilize.path.smoothing import METHODS, orientations_from_rotations, smooth_orientations
-from stabilize.path.zoom import CROP_MODES, choose_zoom
+The names below load when first used, so the command line can read the registries of
+methods and crop modes without loading the planner (and its warps).
+"""
 
-__all__ = [
-    "CROP_MODES",
-    "METHODS",
-    "choose_zoom",
-    "orientations_from_rotations",
-    "plan_path",
-    "smooth_orientations",
-]
+from __future__ import annotations
+
+from stabilize.lazy import lazy_exports
+
+_EXPORTS = {
+    "CROP_MODES": "stabilize.path.zoom",
+    "METHODS": "stabilize.path.smoothing",
+    "choose_zoom": "stabilize.path.zoom",
+    "orientations_from_rotations": "stabilize.path.smoothing",
+    "plan_path": "stabilize.path.plan",
+    "smooth_orientations": "stabilize.path.smoothing",
+}
+
+__all__ = sorted(_EXPORTS)
+
+__getattr__, __dir__ = lazy_exports("stabilize.path", _EXPORTS)

@@ -16,17 +16,20 @@ holds one orientation, as on a tripod.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import sparse
 
 from rotation import so3
+
+if TYPE_CHECKING:
+    from scipy.sparse import csr_array
 
 ADAPTIVE_REF_DEG_S = 30.0  # angular speed at which the window halves
 
 
-def gaussian_band(times: NDArray, sigma: float, reach: float = 4.0) -> sparse.csr_array:
+def gaussian_band(times: NDArray, sigma: float, reach: float = 4.0) -> csr_array:
     """g_ij = exp(-½ ((t_i - t_j) / σ)²) for |t_i - t_j| ≤ reach·σ, else 0: an (N, N)
     sparse matrix over sorted ``times``, whose memory grows with the clip's length, not
     with its square (a dense one would need 2.6 GB for ten minutes at 30 fps).
@@ -34,6 +37,8 @@ def gaussian_band(times: NDArray, sigma: float, reach: float = 4.0) -> sparse.cs
     >>> gaussian_band(np.arange(5) / 30, 0.01).nnz  # each frame, and its neighbours
     13
     """
+    from scipy.sparse import csr_array  # loaded with the planner, not the command line
+
     times = np.asarray(times, dtype=np.float64)
     n = len(times)
     lo = np.searchsorted(times, times - reach * sigma)
@@ -43,7 +48,7 @@ def gaussian_band(times: NDArray, sigma: float, reach: float = 4.0) -> sparse.cs
     starts = np.repeat(np.cumsum(counts) - counts, counts)  # each row's first entry
     cols = np.repeat(lo, counts) + np.arange(counts.sum()) - starts
     weights = np.exp(-0.5 * ((times[rows] - times[cols]) / sigma) ** 2)
-    return sparse.csr_array((weights, (rows, cols)), shape=(n, n))
+    return csr_array((weights, (rows, cols)), shape=(n, n))
 
 
 def _gaussian_mean(O: NDArray, times: NDArray, sigma: NDArray) -> NDArray:
