@@ -29,8 +29,10 @@ from stabilize.gyro.log import GyroLog
 from stabilize.motion.estimate import READOUT_BANDS
 from stabilize.motion.focal import estimate_motion
 from stabilize.motion.repair import repair_unreliable
+from stabilize.motion.residual import reexpress
 from stabilize.motion.track import VisualTrack
 from stabilize.path.plan import plan_path
+from stabilize.path.residual import MOTION_MODELS
 from stabilize.path.smoothing import METHODS
 from stabilize.path.zoom import CROP_MODES
 from stabilize.progress import ProgressFactory, no_progress
@@ -91,11 +93,11 @@ def stabilize_video(
     )
     if focal.note:
         tell(f"focal length: {focal.note}")
-    R, rolling, repaired, gyro_summary = _rotations(settings, job, track)
+    R, rolling, residual, repaired, gyro_summary = _rotations(settings, job, track, focal.px)
     t_estimate = time.perf_counter() - start
     K = _camera_matrix(focal.px, job.info, job.lens)
     planned = plan_path(
-        track.times, R, track.support, K, job.info.size, settings, rolling, job.lens
+        track.times, R, track.support, K, job.info.size, settings, rolling, job.lens, residual
     )
     t_plan = time.perf_counter() - start - t_estimate
     frames = _write(
@@ -168,18 +170,26 @@ def compiling_notice() -> tuple[str, ...]:
     return (f"compiling the estimator's kernels: about 20 s, once (cached in {cache_dir()})",)
 
 
-def _rotations(settings: Settings, job: Job, track: VisualTrack) -> tuple:
-    """(R_t, rolling-shutter turns or None, frames repaired, gyro summary or None): from
-    the gyro log when there is one, else the visual track with unreliable frames repaired."""
+def _rotations(settings: Settings, job: Job, track: VisualTrack, focal: float) -> tuple:
+    """(R_t, rolling-shutter turns or None, the similarities R_t leaves, frames repaired,
+    gyro summary or None): from the gyro log when there is one, else the visual track
+    with unreliable frames repaired (and no residual motion on them)."""
+    reliable = np.ones(len(track.rotations), bool)
     if job.log is not None:
         from stabilize.gyro.path import gyro_path  # gyro mode only
 
         R, rolling, summary = gyro_path(
             settings, job.log, track, job.info.height, job.lens, job.stamps
         )
-        return R, rolling, 0, summary
-    R, reliable = repair_unreliable(track.rotations, track.support)
-    return R, None, int((~reliable).sum()), None
+    else:
+        R, reliable = repair_unreliable(track.rotations, track.support)
+        rolling, summary = None, None
+    residual = track.residual
+    if residual is not None:
+        residual = np.where(reliable[:, None], residual, 0.0)
+        if job.log is not None:  # measured after the visual rotations, not the gyro's
+            residual = reexpress(residual, track.rotations, R, focal, job.info.size)
+    return R, rolling, residual, int((~reliable).sum()), summary
 
 
 def _write(
@@ -202,6 +212,10 @@ def check_settings(settings: Settings) -> None:
         (settings.flow in flow.BACKENDS, f"--flow must be one of {', '.join(flow.BACKENDS)}"),
         (settings.method in METHODS, f"--method must be one of {', '.join(METHODS)}"),
         (settings.crop in CROP_MODES, f"--crop must be one of {', '.join(CROP_MODES)}"),
+        (
+            settings.motion in MOTION_MODELS,
+            f"--motion must be one of {', '.join(MOTION_MODELS)}",
+        ),
         (settings.device in ("cpu", "cuda"), "--device must be cpu or cuda"),
         (
             settings.fov in (None, "auto")

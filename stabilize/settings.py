@@ -13,9 +13,8 @@ from stabilize.video.encode import Encoding
 # A phone's main camera is about 26 mm full-frame equivalent: 69° across the long side.
 DEFAULT_HFOV = 69.0
 # Crop at most 13% of each side: about what FFmpeg's vid.stab zooms to (optzoom=1). Where
-# removing all the shake would need more, the path keeps some of it
-# (:func:`stabilize.path.budget.respect_zoom_budget`); on our test clips that cost almost
-# no steadiness (street: 0.943 → 0.942).
+# removing all the shake would need more, the path keeps as little of it as a linear
+# programme finds (:mod:`stabilize.path.optimal`).
 DEFAULT_MAX_ZOOM = 1.15
 
 
@@ -34,6 +33,9 @@ class Settings:
     focal: float | None = None  # pixels; overrides fov
     smooth: float = 0.5  # smoothing time constant, s
     method: str = "adaptive"  # smoothing method (stabilize.path.smoothing.METHODS)
+    # what the warp compensates: the rotation alone, or also the image motion it leaves
+    # (stabilize.path.residual.MOTION_MODELS)
+    motion: str = "translation"
     max_zoom: float = DEFAULT_MAX_ZOOM
     crop: str = "auto"  # zoom mode (stabilize.path.zoom.CROP_MODES)
     max_deg: float = 15.0  # the estimator's search range per frame pair

@@ -20,9 +20,10 @@ import typer
 import flow
 from stabilize.cli.app import fail
 from stabilize.gyro.readers import FORMATS, GYRO_SIDECARS
+from stabilize.path.residual import MOTION_MODELS
 from stabilize.path.smoothing import METHODS
 from stabilize.path.zoom import CROP_MODES
-from stabilize.settings import Settings
+from stabilize.settings import DEFAULTS, Settings
 from stabilize.video.encode import Encoding
 
 FlowOption = Annotated[
@@ -55,8 +56,24 @@ MethodOption = Annotated[
     Literal[tuple(METHODS)],
     typer.Option(help="adaptive (follows pans), gaussian, or lock (a tripod: one orientation)."),
 ]
+MotionOption = Annotated[
+    Literal[tuple(MOTION_MODELS)],
+    typer.Option(
+        help="What the warp compensates: the camera's rotation alone (exact for distant "
+        "scenes), or also the image motion it leaves, measured on the background the "
+        "rotation vote kept: translation, or similarity (translation, zoom and roll: a "
+        "walk's bob and sway past near surfaces).",
+    ),
+]
 LockOption = Annotated[bool, typer.Option(help="Hold one orientation, like a tripod.")]
-MaxZoomOption = Annotated[float, typer.Option(min=1.0, help="Never zoom in more than this.")]
+MaxZoomOption = Annotated[
+    float,
+    typer.Option(
+        min=1.0,
+        help="Never zoom in more than this; where removing all the shake would need more, "
+        "the path is the steadiest one within it (no border shows).",
+    ),
+]
 CropOption = Annotated[
     Literal[tuple(CROP_MODES)],
     typer.Option(help="auto (one zoom), dynamic (smoothly varying), none."),
@@ -148,6 +165,7 @@ def job_settings(params: Mapping[str, Any]) -> Settings:
         focal=params["focal"],
         smooth=params["smooth"],
         method="lock" if params["lock"] else params["method"],
+        motion=params.get("motion", DEFAULTS.motion),
         max_zoom=params["max_zoom"],
         crop=params["crop"],
         preview=preview == "side-by-side",

@@ -4,7 +4,9 @@ Frames are decoded at about 480 px (:func:`flow.working_size`), the flow between
 consecutive frames is computed ``ESTIMATE_CHUNK`` fields at a time, and the Hough
 estimator (:mod:`rotation`) turns each field into R_t. With ``bands``, each pair's
 rotation is also estimated from horizontal bands of the frame alone, which dates the
-rows of a rolling-shutter frame (:attr:`VisualTrack.bands`).
+rows of a rolling-shutter frame (:attr:`VisualTrack.bands`). The similarity each
+rotation leaves in the frame (the parallax of a walk) is measured on the vectors its vote
+kept (:mod:`stabilize.motion.residual`).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import flow
 from flow.resize import WorkingSize
 from rotation import HoughEstimator
 from rotation.camera import scale_intrinsics
+from stabilize.motion.residual import residual_motion
 from stabilize.motion.track import Samples, VisualTrack, mean_row
 from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
@@ -58,9 +61,10 @@ def estimate_rotations(
     estimator, frames = _estimator_and_frames(path, info, settings, ws, lens)
     found: list[list[tuple]] = [[] for _ in range(bands + 1)]  # whole frame, then bands
     kept: list[tuple] = []
+    residual: list[NDArray] = []
     masks = band_masks(estimator, ws.size[0], bands)
     for u, v, valid in _sampled(estimator, backend.many(frames)):
-        _vote(estimator, u, v, valid, masks, found)
+        residual.append(_vote(estimator, u, v, valid, masks, found))
         if keep_samples:
             kept.append((u.astype(np.float32), v.astype(np.float32), valid))
         progress(len(u))
@@ -77,7 +81,7 @@ def estimate_rotations(
     samples = None
     if kept:
         samples = Samples(*(np.concatenate(parts) for parts in zip(*kept, strict=True)))
-    return replace(_track(times, found, bands), samples=samples)
+    return replace(_track(times, found, bands), samples=samples, residual=np.concatenate(residual))
 
 
 def estimate_again(estimator: HoughEstimator, track: VisualTrack, bands: int = 0) -> VisualTrack:
@@ -87,10 +91,13 @@ def estimate_again(estimator: HoughEstimator, track: VisualTrack, bands: int = 0
     samples = track.samples
     found: list[list[tuple]] = [[] for _ in range(bands + 1)]
     masks = band_masks(estimator, estimator.size[0], bands)
+    residual = []
     for first in range(0, len(samples.u), ESTIMATE_CHUNK):
         part = slice(first, first + ESTIMATE_CHUNK)
-        _vote(estimator, samples.u[part], samples.v[part], samples.valid[part], masks, found)
-    return replace(_track(track.times, found, bands), samples=samples)
+        u, v, valid = samples.u[part], samples.v[part], samples.valid[part]
+        residual.append(_vote(estimator, u, v, valid, masks, found))
+    again = _track(track.times, found, bands)
+    return replace(again, samples=samples, residual=np.concatenate(residual))
 
 
 def _track(times: NDArray, found: list[list[tuple]], bands: int) -> VisualTrack:
@@ -149,10 +156,17 @@ def _vote(
     valid: NDArray,
     masks: list[NDArray],
     found: list[list[tuple]],
-) -> None:
-    """(R, support, mean row) of each pair into ``found``: whole frame, then each band."""
-    sample_rows = estimator.grid.rows
+) -> NDArray:
+    """(R, support, mean row) of each pair into ``found``: whole frame, then each band;
+    returns the similarity (n, 4) each whole-frame rotation leaves."""
+    grid = estimator.grid
     height = estimator.size[0]
+    residual = np.zeros((len(u), 4))
     for b, mask in enumerate(masks):
-        for est in estimator.estimate_samples(u, v, valid & mask):
-            found[b].append((est.matrix, est.support, mean_row(est, sample_rows, height)))
+        estimates = estimator.estimate_samples(u, v, valid & mask)
+        for est in estimates:
+            found[b].append((est.matrix, est.support, mean_row(est, grid.rows, height)))
+        if b == 0:
+            R = np.array([est.matrix for est in estimates])
+            residual = residual_motion(grid.x, grid.y, u, v, valid, R, estimator.focal)
+    return residual

@@ -43,6 +43,9 @@ class VisualTrack:
     band_rows: NDArray[np.float64] | None = None  # (B, N-1) their mean heights
     band_support: NDArray[np.float64] | None = None  # (B, N-1)
     samples: Samples | None = None  # the flow vectors read, where kept
+    # (N-1, 4) the similarity (dx, dy, a, b) left after each rotation, normalised image
+    # coordinates (:mod:`stabilize.motion.residual`)
+    residual: NDArray[np.float64] | None = None
 
     @classmethod
     def from_rotations(cls, times: NDArray, rotations: NDArray) -> VisualTrack:
@@ -63,6 +66,7 @@ class VisualTrack:
             cut(self.band_rows),
             cut(self.band_support),
             None if self.samples is None else self.samples.pairs(first, stop),
+            None if self.residual is None else self.residual[first:stop],
         )
 
 

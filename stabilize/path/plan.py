@@ -1,12 +1,14 @@
 """Planning the camera path: smooth it, keep it within the zoom budget, choose the zoom.
 
-Orientations O_{t+1} = R_t O_t are smoothed on SO(3) into S_t (:mod:`.smoothing`); the
-correction C_t = S_t O_tᵀ of each frame needs some zoom to hide the borders
-(:mod:`stabilize.warp.coverage`); where it needs more than the budget, the path is bent
-(:mod:`.budget`); then the crop mode picks the zoom (:mod:`.zoom`).
+Orientations O_{t+1} = R_t O_t are smoothed on SO(3) into S_t (:mod:`.smoothing`), and
+the image motion each rotation leaves, chained into a 2-D path, is smoothed too
+(:mod:`.residual`); the correction D_t S_t O_tᵀ of each frame needs some zoom to hide the
+borders (:mod:`stabilize.warp.coverage`); where it needs more than the budget, the path
+is the steadiest one within it (:mod:`.optimal`; should that programme fail, both are
+bent, :mod:`.budget`); then the crop mode picks the zoom (:mod:`.zoom`).
 
 With a rolling shutter, each frame's correction also undoes the camera's turn between
-its middle row and every other row, C_t(y) = C_t D_t(y)ᵀ.
+its middle row and every other row, C_t(y) = C_t R_t(y)ᵀ.
 """
 
 from __future__ import annotations
@@ -14,12 +16,14 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.path.budget import respect_zoom_budget
+from stabilize.path import residual as planar
+from stabilize.path.budget import Trajectory, respect_zoom_budget
+from stabilize.path.optimal import optimal_path
 from stabilize.path.smoothing import orientations_from_rotations, smooth_orientations
 from stabilize.path.zoom import CROP_MODES, choose_zoom
 from stabilize.settings import Settings
 from stabilize.warp.camera_path import CameraPath
-from stabilize.warp.coverage import Framing
+from stabilize.warp.coverage import CORNERS, Framing
 from stabilize.warp.homography import homography
 from stabilize.warp.lens import Lens
 from stabilize.warp.rolling import RollingShutter
@@ -36,37 +40,75 @@ def plan_path(
     settings: Settings,
     rolling: RollingShutter | None = None,
     lens: Lens | None = None,
+    residual: NDArray | None = None,
 ) -> CameraPath:
-    """The planned path of frames at ``times`` with rotations R_t (N-1, 3, 3)."""
+    """The planned path of frames at ``times`` with rotations R_t (N-1, 3, 3), and the
+    similarities (N-1, 4) they leave (``residual``; compensated as ``settings.motion``
+    says)."""
     if settings.crop not in CROP_MODES:
         raise ValueError(f"crop must be one of {tuple(CROP_MODES)}, got {settings.crop!r}")
-    O = orientations_from_rotations(rotations)
-    S = smooth_orientations(O, times, settings.smooth, settings.method)
+    measured = residual is not None and settings.motion != "rotation"
+    if not measured:
+        residual = np.zeros((len(rotations), 4))
+    raw = Trajectory(orientations_from_rotations(rotations), planar.path_of(residual))
+    O = raw.turn
+
+    def planned(smooth: float) -> Trajectory:
+        S = smooth_orientations(O, times, smooth, settings.method)
+        hold = settings.method == "lock"
+        return Trajectory(S, planar.smooth_path(raw.shift, times, smooth, settings.motion, hold))
+
     framing = Framing(K, size, None if rolling is None else rolling.rows, lens)
 
-    def corrections(path: NDArray, frames: NDArray | slice = slice(None)) -> NDArray:
-        C = path @ np.swapaxes(O[frames], -1, -2)
-        return C if rolling is None else rolling.corrections(C, frames)
+    def corrections(part: Trajectory, frames: NDArray | slice = slice(None)) -> NDArray:
+        D = planar.corrections(raw.shift[frames], part.shift)
+        C = part.turn @ np.swapaxes(O[frames], -1, -2)
+        return D @ C if rolling is None else D[:, None] @ rolling.corrections(C, frames)
 
-    def zoom_of(path: NDArray, frames: NDArray) -> NDArray:
-        return framing.required_zooms(corrections(path, frames), settings.max_zoom * 1.001)
+    def zoom_of(part: Trajectory, frames: NDArray) -> NDArray:
+        return framing.required_zooms(corrections(part, frames), settings.max_zoom * 1.001)
 
-    def over(path: NDArray, frames: NDArray) -> NDArray:
+    def over(part: Trajectory, frames: NDArray) -> NDArray:
         zoom = np.full(len(frames), settings.max_zoom)
-        return ~framing.covered(corrections(path, frames), zoom)
+        return ~framing.covered(corrections(part, frames), zoom)
 
+    def sources(part: Trajectory, frames: NDArray) -> NDArray:
+        zoom = np.full(len(frames), settings.max_zoom)
+        return framing.border_sources(corrections(part, frames), zoom)
+
+    path = planned(settings.smooth)
+    everything = np.arange(len(O))
     if settings.crop == "none":
         need = np.ones(len(O))
+    elif over(path, everything).any():
+        parts = planar.MOTION_MODELS[settings.motion] if measured else ()
+        solved = optimal_path(path, sources, size, parts, CORNERS, _ceiling(raw, path, parts))
+        if solved is not None:
+            path, need = solved, zoom_of(solved, everything)
+        else:  # the programme failed: bend, first giving up the slow part of the smoothing
+            looser = planned(settings.smooth * LOOSER)
+            path, need = respect_zoom_budget(
+                raw, path, times, zoom_of, settings.max_zoom, settings.smooth, (looser,), over
+            )
     else:
-        # Where the budget binds, first give up only the slow part of the smoothing.
-        looser = smooth_orientations(O, times, settings.smooth * LOOSER, settings.method)
-        S, need = respect_zoom_budget(
-            O, S, times, zoom_of, settings.max_zoom, settings.smooth, via=(looser,), over=over
-        )
+        need = zoom_of(path, everything)
     zoom = choose_zoom(need, times, settings.crop, settings.max_zoom, settings.smooth)
-    C = S @ np.swapaxes(O, -1, -2)
-    H = np.array([homography(K, c, z) for c, z in zip(C, zoom, strict=True)])
+    D = planar.corrections(raw.shift, path.shift)
+    C = D @ path.turn @ np.swapaxes(O, -1, -2)
+    H = homography(K, C, zoom)
+    S = path.turn
     if rolling is None:
-        return CameraPath(times, rotations, support, O, S, zoom, H, K, lens=lens)
+        return CameraPath(times, rotations, support, O, S, zoom, H, K, lens=lens, shift=D)
     rows = framing.rows
-    return CameraPath(times, rotations, support, O, S, zoom, H, K, corrections(S), rows, lens)
+    return CameraPath(
+        times, rotations, support, O, S, zoom, H, K, corrections(path), rows, lens, shift=D
+    )
+
+
+def _ceiling(raw: Trajectory, path: Trajectory, parts: tuple[int, ...]) -> NDArray:
+    """Upper bounds on the optimiser's deviations: none, but the 2-D correction may
+    never zoom in (the zoom alone spends the crop budget)."""
+    ceiling = np.full((len(raw.turn), 3 + len(parts)), np.inf)
+    if 3 in parts:
+        ceiling[:, 3 + parts.index(3)] = raw.shift[:, 3] - path.shift[:, 3]
+    return ceiling

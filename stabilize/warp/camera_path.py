@@ -39,6 +39,16 @@ class CameraPath:
     row_corrections: NDArray | None = None
     knot_rows: NDArray | None = None
     lens: Lens | None = None  # fisheye: frames are warped through it, not by homographies
+    # (N, 3, 3) the 2-D correction D_t after the rotation (normalised coordinates; the
+    # homographies and the row corrections include it)
+    shift: NDArray | None = None
+
+    @property
+    def corrections(self) -> NDArray:
+        """C_t (N, 3, 3) of each frame's middle row: D_t S_t O_tᵀ, the turn to the planned
+        orientation, then the 2-D correction."""
+        C = self.smooth @ np.swapaxes(self.raw, -1, -2)
+        return C if self.shift is None else self.shift @ C
 
     def warp_many(
         self, batch: Sequence[tuple[int, NDArray[np.uint8]]], device: str = "cpu"
@@ -68,7 +78,7 @@ class CameraPath:
         if self.lens is None and not rolling:
             H = self.homographies[k]
             return warp_planes(frame, H) if planar else warp_frame(frame, H)
-        C = self.row_corrections[k] if rolling else self.smooth[k] @ self.raw[k].T
+        C = self.row_corrections[k] if rolling else self.corrections[k]
         if self.lens is not None:
             source = lens_source(self.lens, C, self.zoom[k], self.knot_rows)
         else:

@@ -19,6 +19,8 @@ from stabilize.warp.sources import homography_sources, lens_sources
 
 BORDER_SAMPLES = 16  # points per edge checked for coverage
 ZOOM_STEPS = 16  # bisection steps of the zoom search
+# The output's corners among the border points (the ends of the top and bottom edges).
+CORNERS = np.array([0, BORDER_SAMPLES - 1, BORDER_SAMPLES, 2 * BORDER_SAMPLES - 1])
 
 
 def _border(size: tuple[int, int]) -> NDArray:

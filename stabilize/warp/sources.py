@@ -45,9 +45,10 @@ def lens_sources(
     lens: Lens, C: NDArray, zoom: NDArray, pts: NDArray, rows: NDArray | None = None
 ) -> NDArray[np.float64]:
     """Input pixels (N, M, 2) of output pixels ``pts`` (M, 2) through a lens: unproject
-    with the lens at f·zoom, turn by Cᵀ, project with the lens. ``C`` (N, 3, 3), or
-    (N, B, 3, 3) at knot ``rows``; NaN outside the lens's reach."""
-    C = np.asarray(C, dtype=np.float64)
+    with the lens at f·zoom, map by C⁻¹ (Cᵀ for a pure turn; C may carry a 2-D
+    correction too), project with the lens. ``C`` (N, 3, 3), or (N, B, 3, 3) at knot
+    ``rows``; NaN outside the lens's reach."""
+    C = np.swapaxes(np.linalg.inv(np.asarray(C, dtype=np.float64)), -1, -2)
     zoom = np.asarray(zoom, dtype=np.float64)
     n, m = len(C), len(pts)
     c = lens.K[:2, 2]

@@ -75,7 +75,7 @@ def test_the_residual_jitter_is_a_fraction_of_the_input(shaky, stabilised):
         size=tuple(opts["size"]),
     ).motion
     O_true = trajectory.orientation(motion, planned.times)
-    C = planned.smooth @ np.swapaxes(planned.raw, -1, -2)
+    C = planned.smooth @ np.swapaxes(planned.raw, -1, -2)  # the turn (no 2-D part)
     out = C @ O_true  # the output camera's true orientation
 
     def jitter(O):

@@ -1,0 +1,68 @@
+"""The image motion a rotation leaves: recovered on the background, crowds ignored."""
+
+import numpy as np
+import pytest
+
+from rotation import so3
+from stabilize.motion.residual import reexpress, residual_motion
+
+F = 400.0
+
+
+def _grid():
+    xs, ys = np.meshgrid(np.arange(-300.0, 301.0, 15.0), np.arange(-170.0, 171.0, 15.0))
+    return xs.ravel(), ys.ravel()
+
+
+def _flow(x, y, R, shift, scale=0.0):
+    """Flow of points turned by R, then moved by ``shift`` px and zoomed by 1+scale."""
+    rays = np.stack([x, y, np.full_like(x, F)], 1) @ R.T
+    px, py = F * rays[:, 0] / rays[:, 2], F * rays[:, 1] / rays[:, 2]
+    return px + shift[0] + scale * px - x, py + shift[1] + scale * py - y
+
+
+def test_a_translation_left_after_the_rotation_is_recovered():
+    x, y = _grid()
+    R = so3.exp_so3(np.array([0.01, -0.02, 0.004]))
+    u, v = _flow(x, y, R, (2.0, -1.5))
+    rng = np.random.default_rng(0)
+    u, v = u + rng.normal(0, 0.2, u.shape), v + rng.normal(0, 0.2, v.shape)
+    valid = np.ones((1, len(x)), bool)
+    dx, dy, a, b = residual_motion(x, y, u[None], v[None], valid, R[None], F)[0]
+    assert dx * F == pytest.approx(2.0, abs=0.03) and dy * F == pytest.approx(-1.5, abs=0.03)
+    assert abs(a) < 1e-4 and abs(b) < 1e-4
+
+
+def test_a_crowd_moving_across_the_frame_does_not_drag_the_background():
+    x, y = _grid()
+    R = so3.exp_so3(np.array([0.0, 0.015, 0.0]))
+    u, v = _flow(x, y, R, (0.8, 0.0))
+    crowd = (x > 0) & (y > -60)  # a third of the frame walks right at 6 px a frame
+    assert 0.25 < crowd.mean() < 0.4
+    u[crowd] += 6.0
+    valid = np.ones((1, len(x)), bool)
+    dx, dy, _, _ = residual_motion(x, y, u[None], v[None], valid, R[None], F)[0]
+    assert dx * F == pytest.approx(0.8, abs=0.05) and abs(dy * F) < 0.05
+    # Without the gate and the Cauchy weights, least squares follows the crowd:
+    mean_dx = np.mean(u - _flow(x, y, R, (0.0, 0.0))[0])
+    assert mean_dx > 2.0
+
+
+def test_too_few_vectors_give_no_motion():
+    x, y = _grid()
+    u, v = _flow(x, y, np.eye(3), (1.0, 1.0))
+    valid = np.zeros((1, len(x)), bool)
+    valid[0, :10] = True
+    assert not residual_motion(x, y, u[None], v[None], valid, np.eye(3)[None], F).any()
+
+
+def test_a_residual_reexpressed_after_another_rotation_matches_one_measured_after_it():
+    x, y = _grid()
+    R_true = so3.exp_so3(np.array([0.01, 0.02, -0.003]))
+    u, v = _flow(x, y, R_true, (1.0, 0.5))
+    valid = np.ones((1, len(x)), bool)
+    R_other = so3.exp_so3(np.array([0.011, 0.019, -0.003]))  # a gyro's, say: 0.08° off
+    direct = residual_motion(x, y, u[None], v[None], valid, R_other[None], F)
+    measured = residual_motion(x, y, u[None], v[None], valid, R_true[None], F)
+    moved = reexpress(measured, R_true[None], R_other[None], F, (360, 640))
+    assert np.abs((moved - direct)[:, :2]).max() * F < 0.05

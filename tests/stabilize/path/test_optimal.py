@@ -1,0 +1,81 @@
+"""The steadiest path within the crop budget (the L1 programme)."""
+
+import numpy as np
+import pytest
+
+from rotation import so3
+from rotation.camera import intrinsics
+from stabilize.path.budget import Trajectory, respect_zoom_budget
+from stabilize.path.optimal import optimal_path
+from stabilize.path.plan import plan_path
+from stabilize.path.smoothing import smooth_orientations
+from stabilize.settings import Settings
+from stabilize.warp.coverage import CORNERS, Framing
+from tests.stabilize.helpers import shaky_path
+
+K = intrinsics(500.0, (360, 640))
+SIZE = (360, 640)
+
+
+def _jitter(S):
+    """Std of the output camera's angular acceleration, deg per frame²."""
+    steps = so3.log_so3(S[1:] @ np.swapaxes(S[:-1], -1, -2))
+    return float(np.std(np.diff(np.degrees(steps), axis=0)))
+
+
+def _rotations(O):
+    return O[1:] @ np.swapaxes(O[:-1], -1, -2)
+
+
+@pytest.mark.parametrize("motion", ["rotation", "translation", "similarity"])
+def test_every_frame_covers_the_output(motion):
+    t, O = shaky_path(n=200, shake_deg=2.0, seed=4)
+    rng = np.random.default_rng(5)
+    residual = np.c_[rng.normal(0, 0.004, (199, 2)), rng.normal(0, 0.002, (199, 2))]
+    settings = Settings(max_zoom=1.08, motion=motion)
+    planned = plan_path(t, _rotations(O), np.ones(199), K, SIZE, settings, residual=residual)
+    assert planned.zoom.max() <= 1.08 + 1e-9
+    assert Framing(K, SIZE).covered(planned.corrections, planned.zoom + 1e-6).all()
+
+
+def test_under_a_binding_budget_it_is_steadier_than_the_bent_path():
+    t, O = shaky_path(n=240, shake_deg=2.0, seed=7)
+    framing = Framing(K, SIZE)
+    max_zoom = 1.06
+    S = smooth_orientations(O, t, 0.5)
+    still = np.zeros((len(O), 4))
+    raw, target = Trajectory(O, still), Trajectory(S, still)
+
+    def corrections(part, frames):
+        return part.turn @ np.swapaxes(O[frames], -1, -2)
+
+    def zoom_of(part, frames):
+        return framing.required_zooms(corrections(part, frames), max_zoom * 1.001)
+
+    def sources(part, frames):
+        return framing.border_sources(corrections(part, frames), np.full(len(frames), max_zoom))
+
+    everything = np.arange(len(O))
+    assert (zoom_of(target, everything) > max_zoom).mean() > 0.3  # the budget binds
+    bent, _ = respect_zoom_budget(raw, target, t, zoom_of, max_zoom, 0.5)
+    best = optimal_path(target, sources, SIZE, (), CORNERS)
+    assert best is not None
+    assert framing.covered(corrections(best, everything), np.full(len(O), max_zoom)).all()
+    assert _jitter(best.turn) < 0.8 * _jitter(bent.turn)
+
+
+def test_where_the_budget_is_not_reached_the_path_is_the_smoothed_one():
+    t, O = shaky_path(n=120, shake_deg=0.3, seed=2)
+    planned = plan_path(t, _rotations(O), np.ones(119), K, SIZE, Settings(max_zoom=1.3))
+    assert np.allclose(planned.smooth, smooth_orientations(planned.raw, t, 0.5))
+
+
+def test_long_clips_are_solved_in_windows_that_join_smoothly():
+    t, O = shaky_path(n=400, shake_deg=2.0, seed=9)
+    planned = plan_path(t, _rotations(O), np.ones(399), K, SIZE, Settings(max_zoom=1.06))
+    assert Framing(K, SIZE).covered(planned.corrections, planned.zoom + 1e-6).all()
+    steps = np.degrees(so3.angle(_rotations(planned.smooth)))
+    raw_steps = np.degrees(so3.angle(_rotations(O)))
+    # No jump where windows meet (every 110 frames): the output never turns faster
+    # than the raw camera's fastest frame.
+    assert steps.max() < raw_steps.max()
