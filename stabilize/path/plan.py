@@ -93,16 +93,11 @@ def plan_path(
     else:
         need = zoom_of(path, everything)
     zoom = choose_zoom(need, times, settings.crop, settings.max_zoom, settings.smooth)
-    D = planar.corrections(raw.shift, path.shift)
-    C = D @ path.turn @ np.swapaxes(O, -1, -2)
-    H = homography(K, C, zoom)
-    S = path.turn
-    if rolling is None:
-        return CameraPath(times, rotations, support, O, S, zoom, H, K, lens=lens, shift=D)
+    S, D = path.turn, planar.corrections(raw.shift, path.shift)
+    H = homography(K, D @ S @ np.swapaxes(O, -1, -2), zoom)  # the middle row's
+    by_row = None if rolling is None else corrections(path)
     rows = framing.rows
-    return CameraPath(
-        times, rotations, support, O, S, zoom, H, K, corrections(path), rows, lens, shift=D
-    )
+    return CameraPath(times, rotations, support, O, S, zoom, H, K, by_row, rows, lens, shift=D)
 
 
 def _ceiling(raw: Trajectory, path: Trajectory, parts: tuple[int, ...]) -> NDArray:
