@@ -23,7 +23,7 @@ from stabilize.gyro.readers import FORMATS, GYRO_SIDECARS
 from stabilize.path.residual import MOTION_MODELS
 from stabilize.path.smoothing import METHODS
 from stabilize.path.zoom import CROP_MODES
-from stabilize.settings import DEFAULTS, Settings
+from stabilize.settings import Settings
 from stabilize.video.encode import Encoding
 
 FlowOption = Annotated[
@@ -60,9 +60,9 @@ MotionOption = Annotated[
     Literal[tuple(MOTION_MODELS)],
     typer.Option(
         help="What the warp compensates: the camera's rotation alone (exact for distant "
-        "scenes), or also the image motion it leaves, measured on the background the "
-        "rotation vote kept: translation, or similarity (translation, zoom and roll: a "
-        "walk's bob and sway past near surfaces).",
+        "scenes), or also the image motion it leaves on the background (the vectors "
+        "within 3 px of where the rotation puts them): translation (a walk's sway past "
+        "near surfaces), or similarity (also roll and zoom).",
     ),
 ]
 LockOption = Annotated[bool, typer.Option(help="Hold one orientation, like a tripod.")]
@@ -165,7 +165,7 @@ def job_settings(params: Mapping[str, Any]) -> Settings:
         focal=params["focal"],
         smooth=params["smooth"],
         method="lock" if params["lock"] else params["method"],
-        motion=params.get("motion", DEFAULTS.motion),
+        motion=params["motion"],
         max_zoom=params["max_zoom"],
         crop=params["crop"],
         preview=preview == "side-by-side",

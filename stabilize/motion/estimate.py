@@ -5,8 +5,9 @@ consecutive frames is computed ``ESTIMATE_CHUNK`` fields at a time, and the Houg
 estimator (:mod:`rotation`) turns each field into R_t. With ``bands``, each pair's
 rotation is also estimated from horizontal bands of the frame alone, which dates the
 rows of a rolling-shutter frame (:attr:`VisualTrack.bands`). The similarity each
-rotation leaves in the frame (the parallax of a walk) is measured on the vectors its vote
-kept (:mod:`stabilize.motion.residual`).
+rotation leaves in the frame (the parallax of a walk) is measured on the background's
+vectors, those that land within a few pixels of where the rotation puts them
+(:mod:`stabilize.motion.residual`).
 """
 
 from __future__ import annotations

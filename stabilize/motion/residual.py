@@ -64,17 +64,24 @@ def fit_similarity(
     return np.where(enough[:, None], params, 0.0)
 
 
+def landing(x: NDArray, y: NDArray, R: NDArray, focal: float) -> tuple[NDArray, NDArray]:
+    """Where rotations R (n, 3, 3) put points (x, y) (M,) about the principal point, in
+    pixels at ``focal``: π(R (x, y, f)) in normalised coordinates, (n, M) each."""
+    rays = np.stack([x, y, np.full_like(x, focal)], 1)
+    turned = rays @ np.swapaxes(np.asarray(R, np.float64), -1, -2)  # (n, M, 3)
+    z = np.maximum(turned[..., 2], 1e-9)
+    return turned[..., 0] / z, turned[..., 1] / z
+
+
 def residual_motion(
     x: NDArray, y: NDArray, u: NDArray, v: NDArray, valid: NDArray, R: NDArray, focal: float
 ) -> NDArray[np.float64]:
     """Each pair's similarity (n, 4) left after its rotation: sample points (x, y) (M,)
     about the principal point, their flow u, v (n, M) where ``valid`` (n, M), rotations
     R (n, 3, 3), in pixels at focal length ``focal``."""
-    rays = np.stack([x, y, np.full_like(x, focal)], 1)
-    turned = rays @ np.swapaxes(np.asarray(R, np.float64), -1, -2)  # (n, M, 3)
-    z = np.maximum(turned[..., 2], 1e-9)
-    rx = (x + u - focal * turned[..., 0] / z) / focal
-    ry = (y + v - focal * turned[..., 1] / z) / focal
+    lx, ly = landing(x, y, R, focal)
+    rx = (x + u) / focal - lx
+    ry = (y + v) / focal - ly
     near = valid & (np.hypot(rx, ry) < GATE_PX / focal)
     return fit_similarity(x / focal, y / focal, rx, ry, near, CAUCHY_PX / focal)
 
@@ -90,15 +97,8 @@ def reexpress(
     h, w = size
     gx, gy = np.meshgrid(np.linspace(-w / 2, w / 2, 9), np.linspace(-h / 2, h / 2, 7))
     x, y = gx.ravel(), gy.ravel()
-    rays = np.stack([x, y, np.full_like(x, focal)], 1)
-
-    def landing(R: NDArray) -> tuple[NDArray, NDArray]:
-        q = rays @ np.swapaxes(R, -1, -2)
-        z = np.maximum(q[..., 2], 1e-9)
-        return q[..., 0] / z, q[..., 1] / z
-
-    fx, fy = landing(np.asarray(R_from, np.float64))
-    tx, ty = landing(np.asarray(R_to, np.float64))
+    fx, fy = landing(x, y, R_from, focal)
+    tx, ty = landing(x, y, R_to, focal)
     ones = np.ones((len(residual), len(x)))
     delta = fit_similarity(x / focal, y / focal, fx - tx, fy - ty, ones, np.inf)
     return np.asarray(residual, np.float64) + delta

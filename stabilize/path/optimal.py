@@ -128,13 +128,14 @@ def _solve_window(
     part = target.take(frames)
     x = delta[frames].copy()
     x[fixed:] = 0.0
-    active = np.zeros((len(frames), _points(sources, part, frames)), bool)
-    active[fixed:, corners] = True  # the held frames were checked in the last window
-    margin = np.full(len(frames), MARGIN_PX)
     h, w = size
     lo, hi = np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5])
-    if not x.any() and _outside(sources(part, frames), lo, hi).sum() == 0:
+    on_target = _outside(sources(part, frames), lo, hi)  # (n, M)
+    if not x.any() and not on_target.any():
         return x  # the target fits and nothing carries over: no programme to solve
+    active = np.zeros(on_target.shape, bool)
+    active[fixed:, corners] = True  # the held frames were checked in the last window
+    margin = np.full(len(frames), MARGIN_PX)
     for _ in range(ROUNDS):
         src, jac = _linearised(sources, part, frames, x, parts)
         solved = _programme(
@@ -157,10 +158,6 @@ def _outside(src: NDArray, lo: NDArray, hi: NDArray) -> NDArray[np.bool_]:
     with np.errstate(invalid="ignore"):
         inside = ((src >= lo) & (src <= hi)).all(axis=2)
     return ~inside | ~np.isfinite(src).all(axis=2)
-
-
-def _points(sources: Sources, part: Trajectory, frames: NDArray) -> int:
-    return sources(part.take(slice(0, 1)), frames[:1]).shape[1]
 
 
 def _linearised(

@@ -43,12 +43,12 @@ class CameraPath:
     # homographies and the row corrections include it)
     shift: NDArray | None = None
 
-    @property
-    def corrections(self) -> NDArray:
-        """C_t (N, 3, 3) of each frame's middle row: D_t S_t O_tᵀ, the turn to the planned
-        orientation, then the 2-D correction."""
-        C = self.smooth @ np.swapaxes(self.raw, -1, -2)
-        return C if self.shift is None else self.shift @ C
+    def corrections(self, frames: int | slice | NDArray = slice(None)) -> NDArray:
+        """C_t (3, 3) of frame t's middle row, or a stack of them (every frame's by
+        default): D_t S_t O_tᵀ, the turn to the planned orientation, then the 2-D
+        correction."""
+        C = self.smooth[frames] @ np.swapaxes(self.raw[frames], -1, -2)
+        return C if self.shift is None else self.shift[frames] @ C
 
     def warp_many(
         self, batch: Sequence[tuple[int, NDArray[np.uint8]]], device: str = "cpu"
@@ -78,7 +78,7 @@ class CameraPath:
         if self.lens is None and not rolling:
             H = self.homographies[k]
             return warp_planes(frame, H) if planar else warp_frame(frame, H)
-        C = self.row_corrections[k] if rolling else self.corrections[k]
+        C = self.row_corrections[k] if rolling else self.corrections(k)
         if self.lens is not None:
             source = lens_source(self.lens, C, self.zoom[k], self.knot_rows)
         else:

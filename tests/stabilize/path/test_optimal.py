@@ -35,7 +35,7 @@ def test_every_frame_covers_the_output(motion):
     settings = Settings(max_zoom=1.08, motion=motion)
     planned = plan_path(t, _rotations(O), np.ones(199), K, SIZE, settings, residual=residual)
     assert planned.zoom.max() <= 1.08 + 1e-9
-    assert Framing(K, SIZE).covered(planned.corrections, planned.zoom + 1e-6).all()
+    assert Framing(K, SIZE).covered(planned.corrections(), planned.zoom + 1e-6).all()
 
 
 def test_under_a_binding_budget_it_is_steadier_than_the_bent_path():
@@ -73,7 +73,7 @@ def test_where_the_budget_is_not_reached_the_path_is_the_smoothed_one():
 def test_long_clips_are_solved_in_windows_that_join_smoothly():
     t, O = shaky_path(n=400, shake_deg=2.0, seed=9)
     planned = plan_path(t, _rotations(O), np.ones(399), K, SIZE, Settings(max_zoom=1.06))
-    assert Framing(K, SIZE).covered(planned.corrections, planned.zoom + 1e-6).all()
+    assert Framing(K, SIZE).covered(planned.corrections(), planned.zoom + 1e-6).all()
     steps = np.degrees(so3.angle(_rotations(planned.smooth)))
     raw_steps = np.degrees(so3.angle(_rotations(O)))
     # No jump where windows meet (every 110 frames): the output never turns faster

@@ -29,7 +29,7 @@ def test_the_zoom_budget_is_never_broken(crop):
         t, R, np.ones(len(R)), K, SIZE, Settings(max_zoom=1.1, crop=crop, smooth=1.0)
     )
     assert planned.zoom.max() <= 1.1 + 1e-9
-    C = planned.corrections
+    C = planned.corrections()
     assert all(covers(K, c, z + 1e-6, SIZE) for c, z in zip(C, planned.zoom, strict=True))
 
 

@@ -156,7 +156,7 @@ def test_stabilising_a_fisheye_clip_with_its_lens_profile(fisheye_clip, tmp_path
     assert planned.lens is not None and 1.0 < summary["zoom"] <= 1.15 + 1e-6
     # The zoom is found through the lens: every frame's border stays inside the input.
     size = probe(clip).size
-    for C, zoom in zip(planned.corrections, planned.zoom, strict=True):
+    for C, zoom in zip(planned.corrections(), planned.zoom, strict=True):
         assert covers(planned.K, C, zoom, size, lens=planned.lens)
     means = [frame.mean() for frame in read_frames(out)]
     assert len(means) == 90 and min(means) > 20  # warped content, not black
