@@ -4,7 +4,8 @@ on rendered walks at fields of view the tool is not told.
 Each clip is stabilised by both tools with the same encoder (libx264, CRF 18, preset
 medium; see ``stabilize_bench.py``), and the table gives, for the original and for each
 output, the residual shake (``stabilize evaluate``: the RMS of the high-passed
-frame-to-frame similarity motion, px at the clip's width), stability, cropping,
+frame-to-frame similarity motion, px at the clip's width), the wobble (a rolling
+shutter's shear and stretch between frames, px), stability, cropping,
 distortion and wall time, then the median of ours ÷ vid.stab's residual shake.
 
     python bench/real_bench.py                 # the real clips and three rendered walks
@@ -59,7 +60,8 @@ def main() -> None:
     work = Path(tempfile.mkdtemp(prefix="real-bench-"))
     ratios = []
     header = (
-        f"{'clip':28s}{'tool':10s}{'shake px':>9s}{'stab':>7s}{'crop':>7s}{'dist':>7s}{'s':>7s}"
+        f"{'clip':28s}{'tool':10s}{'shake px':>9s}{'wobble':>7s}{'stab':>7s}{'crop':>7s}"
+        f"{'dist':>7s}{'s':>7s}"
     )
     print(header)
     for clip in args.clips or clips(work):
@@ -85,7 +87,7 @@ def main() -> None:
 def _row(clip: str, tool: str, m, seconds: float | None) -> str:
     t = f"{seconds:7.1f}" if seconds is not None else f"{'':7s}"
     return (
-        f"{clip:28s}{tool:10s}{m.residual_shake_px:9.3f}{m.stability:7.3f}"
+        f"{clip:28s}{tool:10s}{m.residual_shake_px:9.3f}{m.wobble_px:7.3f}{m.stability:7.3f}"
         f"{m.cropping_ratio:7.3f}{m.distortion:7.3f}{t}"
     )
 

@@ -12,6 +12,8 @@ The stages, for a library user who wants one of them alone:
   its frames;
 * :func:`estimate_rotations` (:mod:`stabilize.motion`): pass 1, each frame pair's camera
   rotation, as a :class:`VisualTrack`;
+* :func:`estimate_readout` (:mod:`stabilize.shutter`): a rolling shutter's readout from
+  a track's band rotations (pass 1 with ``bands``), and the attitude fitted at it;
 * :func:`plan_path` (:mod:`stabilize.path`): the smoothed path within the zoom budget,
   as a :class:`CameraPath`;
 * :func:`render` (:mod:`stabilize.warp`): pass 2, the frames warped along that path;
@@ -32,6 +34,7 @@ _EXPORTS = {
     "VideoError": "stabilize.video",
     "estimate_rotations": "stabilize.motion.estimate",
     "VisualTrack": "stabilize.motion.track",
+    "estimate_readout": "stabilize.shutter.readout",
     "plan_path": "stabilize.path.plan",
     "CameraPath": "stabilize.warp.camera_path",
     "render": "stabilize.warp.render",

@@ -3,7 +3,10 @@
 1. **Motion** (pass 1): decode at the flow's working size (~480 px), compute optical flow
    between consecutive frames, and estimate each pair's rotation R_t
    (:mod:`stabilize.motion`); repair the frames too few vectors agreed on, or take the
-   rotations from a gyro log instead (:mod:`stabilize.gyro`).
+   rotations from a gyro log instead (:mod:`stabilize.gyro`). Without a gyro, each
+   pair's rotation is also measured on horizontal bands, which dates the rows of a
+   rolling shutter: the readout, and the per-row turns, come from the video alone
+   (:mod:`stabilize.shutter`).
 2. **Path**: chain the rotations into orientations O_t, smooth them on SO(3), keep them
    within the zoom budget, and choose the zoom (:mod:`stabilize.path`).
 3. **Warp** (pass 2): decode at full resolution, warp each frame by K' C_t K⁻¹, and
@@ -86,14 +89,25 @@ def stabilize_video(
         tell(notice)
     start = time.perf_counter()
     bar = progress or (lambda label, total: no_progress)
-    bands = READOUT_BANDS if settings.gyro and settings.readout_ms == "auto" else 0
+    bands = READOUT_BANDS if dates_rows(settings) else 0
     estimating = bar("estimating", max(len(job.times) - 1, 0))
     track, focal = estimate_motion(
-        src, job.info, settings, estimating, job.times, bands=bands, lens=job.lens
+        src,
+        job.info,
+        settings,
+        estimating,
+        job.times,
+        bands=bands,
+        lens=job.lens,
+        keep_samples=bands > 0 and job.log is None,  # measured again once rows are dated
     )
     if focal.note:
         tell(f"focal length: {focal.note}")
-    R, rolling, residual, repaired, gyro_summary = _rotations(settings, job, track, focal.px)
+    R, rolling, residual, repaired, gyro_summary, shutter = _rotations(
+        settings, job, track, focal.px
+    )
+    if shutter is not None and shutter.source != "off":
+        tell(f"rolling shutter: {shutter.describe()}")
     t_estimate = time.perf_counter() - start
     K = _camera_matrix(focal.px, job.info, job.lens)
     planned = plan_path(
@@ -124,6 +138,7 @@ def stabilize_video(
         "fps": frames / total,
         "settings": settings_summary(settings),
         "gyro": gyro_summary,
+        "rolling_shutter": None if shutter is None else shutter.summary(),
         "notices": list(job.notices),
     }
     return summary, planned
@@ -170,11 +185,21 @@ def compiling_notice() -> tuple[str, ...]:
     return (f"compiling the estimator's kernels: about 20 s, once (cached in {cache_dir()})",)
 
 
+def dates_rows(settings: Settings) -> bool:
+    """Whether pass 1 also measures each band's rotations: to estimate the readout
+    against the gyro, or to fit the visual attitude a rolling shutter is undone by."""
+    if settings.gyro:
+        return settings.readout_ms == "auto"
+    return settings.rolling_shutter not in ("off", 0, 0.0)
+
+
 def _rotations(settings: Settings, job: Job, track: VisualTrack, focal: float) -> tuple:
     """(R_t, rolling-shutter turns or None, the similarities R_t leaves, frames repaired,
-    gyro summary or None): from the gyro log when there is one, else the visual track
-    with unreliable frames repaired (and no residual motion on them)."""
+    gyro summary or None, the visual readout or None): from the gyro log when there is
+    one, else the visual track with unreliable frames repaired (and no residual motion on
+    them); under a rolling shutter, the rotations between the frames' middle rows."""
     reliable = np.ones(len(track.rotations), bool)
+    shutter = None
     if job.log is not None:
         from stabilize.gyro.path import gyro_path  # gyro mode only
 
@@ -184,12 +209,23 @@ def _rotations(settings: Settings, job: Job, track: VisualTrack, focal: float) -
     else:
         R, reliable = repair_unreliable(track.rotations, track.support)
         rolling, summary = None, None
+        from stabilize.shutter import readout_for, visual_rolling_shutter
+
+        shutter, spline = readout_for(settings.rolling_shutter, track)
+        if spline is not None:
+            R, rolling = visual_rolling_shutter(
+                spline, track.times, shutter.seconds, job.info.height
+            )
     residual = track.residual
+    if residual is not None and shutter is not None and rolling is not None:
+        from stabilize.shutter.residual import rectified_residual
+
+        residual = rectified_residual(track.samples, R, rolling, focal, job.info.height)
+    elif residual is not None and job.log is not None:  # measured after the visual rotations
+        residual = reexpress(residual, track.rotations, R, focal, job.info.size)
     if residual is not None:
         residual = np.where(reliable[:, None], residual, 0.0)
-        if job.log is not None:  # measured after the visual rotations, not the gyro's
-            residual = reexpress(residual, track.rotations, R, focal, job.info.size)
-    return R, rolling, residual, int((~reliable).sum()), summary
+    return R, rolling, residual, int((~reliable).sum()), summary, shutter
 
 
 def _write(
@@ -226,6 +262,14 @@ def check_settings(settings: Settings) -> None:
         (settings.smooth > 0, "--smooth must be positive"),
         (settings.max_zoom >= 1.0, "--max-zoom must be at least 1"),
         (settings.gyro_search >= 0, "--gyro-search must not be negative"),
+        (
+            settings.rolling_shutter in ("auto", "off")
+            or (
+                isinstance(settings.rolling_shutter, int | float)
+                and 0 <= settings.rolling_shutter <= 1000
+            ),
+            "--rolling-shutter must be auto, off or 0–1000 ms",
+        ),
         (
             settings.size is None or all(v % 2 == 0 for v in settings.size),
             "--size needs even sides (4:2:0 video)",

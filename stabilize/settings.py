@@ -46,6 +46,8 @@ class Settings:
     gyro_axes: tuple | None = None  # R_cam_imu as nested tuples
     gyro_lpf: float | None = None  # Hz
     readout_ms: float | str | None = None  # rolling shutter: ms, 'auto', or the log's value
+    # rolling shutter without a gyro: 'auto' (estimated from the video), 'off', or ms
+    rolling_shutter: float | str = "auto"
     gyro_drift: bool = False  # also fit a linear clock drift
     gyro_timestamps: str | None = None  # frame times on the gyro clock (a file)
     gyro_search: float = 1.0  # offset search range, ± s (a log on its own clock: all of it)

@@ -12,10 +12,11 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 RANK = {
-    "cli": 8,
-    "batch": 7,
-    "pipeline": 6,
-    "evaluate": 6,
+    "cli": 9,
+    "batch": 8,
+    "pipeline": 7,
+    "evaluate": 7,
+    "shutter": 6,
     "gyro": 5,
     "motion": 4,
     "path": 4,

@@ -33,6 +33,7 @@ from stabilize.cli.options import (
     QuietOption,
     RaftWeightsOption,
     ReadoutOption,
+    RollingShutterOption,
     SizeOption,
     SmoothOption,
     job_settings,
@@ -90,6 +91,7 @@ def batch(
     gyro_lpf: GyroLpfOption = DEFAULTS.gyro_lpf,
     gyro_drift: GyroDriftOption = DEFAULTS.gyro_drift,
     readout_ms: ReadoutOption = None,
+    rolling_shutter: RollingShutterOption = str(DEFAULTS.rolling_shutter),
     quiet: QuietOption = False,
 ) -> None:
     """Stabilise every clip in a folder: resumable, one failure never stops the rest."""

@@ -21,7 +21,12 @@ from stabilize.cli.app import app, fail
         "each frame-to-frame motion (dx, dy, and the rotation and zoom as the px they move "
         "the frame's side, at the clip's width) is high-passed (minus a Gaussian low-pass, "
         "sigma 0.5 s, which keeps pans and walks); the shake is the RMS length of what is "
-        "left, in px, and of its rotation alone, in degrees. Lower is steadier."
+        "left, in px, and of its rotation alone, in degrees. Lower is steadier.\n\n"
+        "Wobble (a rolling shutter's jello): of each frame-to-frame homography (ORB, "
+        "RANSAC), its linear part at the frame's centre [[a, b], [c, d]]; the part no "
+        "similarity has, ((a - d)/2, (b + c)/2), the stretch and the shear, times half the "
+        "clip's width; its RMS over the pairs, in px. About 0 for a global shutter; lower "
+        "is better."
     )
 )
 def evaluate(
@@ -33,7 +38,8 @@ def evaluate(
     ),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON on stdout."),
 ) -> None:
-    """Cropping ratio, distortion, stability and ITF of a stabilised clip and its original."""
+    """Cropping ratio, distortion, stability, ITF, residual shake and wobble of a
+    stabilised clip and its original."""
     from stabilize.evaluate.metrics import evaluate_pair
     from stabilize.motion.files import angular_errors, read_rotations
     from stabilize.video import VideoError, probe, read_frames
@@ -71,6 +77,7 @@ def evaluate(
         ("ITF (dB)", "itf_db", "{:.2f}"),
         ("residual shake (px)", "residual_shake_px", "{:.3f}"),
         ("residual shake (deg)", "residual_shake_deg", "{:.4f}"),
+        ("wobble (px)", "wobble_px", "{:.3f}"),
         ("frames", "frames", "{}"),
     ]
     typer.echo(f"{'metric':26s}{'original':>12s}{'stabilised':>12s}")

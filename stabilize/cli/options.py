@@ -23,7 +23,7 @@ from stabilize.gyro.readers import FORMATS, GYRO_SIDECARS
 from stabilize.path.residual import MOTION_MODELS
 from stabilize.path.smoothing import METHODS
 from stabilize.path.zoom import CROP_MODES
-from stabilize.settings import Settings
+from stabilize.settings import DEFAULTS, Settings
 from stabilize.video.encode import Encoding
 
 FlowOption = Annotated[
@@ -139,6 +139,16 @@ ReadoutOption = Annotated[
         "Default: the log's own value, else none."
     ),
 ]
+RollingShutterOption = Annotated[
+    str,
+    typer.Option(
+        "--rolling-shutter",
+        help="Rolling-shutter readout (top to bottom row), without a gyro: 'auto' estimates "
+        "it from the video and corrects it when measured; 'off' treats the camera as "
+        "global-shutter; or a number of ms. With --gyro a number or 'off' sets the readout "
+        "as --readout-ms does.",
+    ),
+]
 OverwriteOption = Annotated[bool, typer.Option(help="Replace the output if it exists.")]
 QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")]
 JsonOption = Annotated[bool, typer.Option("--json", help="Print the summary as JSON on stdout.")]
@@ -157,6 +167,7 @@ def job_settings(params: Mapping[str, Any]) -> Settings:
     gyro = params.get("gyro")
     axes = params.get("gyro_axes")
     lens = params.get("lens")
+    shutter = rolling_shutter(params.get("rolling_shutter", DEFAULTS.rolling_shutter))
     return flow_settings(
         params["flow_name"],
         params["raft_weights"],
@@ -173,7 +184,8 @@ def job_settings(params: Mapping[str, Any]) -> Settings:
         encoding=Encoding(codec=params["codec"], crf=params["crf"], preset=params["preset"]),
         gyro=str(gyro) if gyro and gyro != "auto" else None,
         gyro_lpf=params["gyro_lpf"],
-        readout_ms=readout(params["readout_ms"], gyro),
+        readout_ms=readout(params["readout_ms"], gyro, shutter),
+        rolling_shutter=shutter,
         gyro_drift=params["gyro_drift"],
         lens=str(lens) if lens else None,
         gyro_format=params["gyro_format"],
@@ -228,10 +240,31 @@ def output_size(text: str | None) -> tuple[int, int] | None:
     return h, w
 
 
-def readout(value: str | None, gyro: object) -> float | str | None:
-    """--readout-ms: a number of ms or 'auto'; rolling-shutter correction needs the gyro."""
+def rolling_shutter(value: str | float) -> float | str:
+    """--rolling-shutter: 'auto', 'off', or a readout of 0..1000 ms."""
+    if value in ("auto", "off"):
+        return value
+    try:
+        ms = float(value)
+    except ValueError:
+        fail(f"--rolling-shutter takes 'auto', 'off' or a number of ms, got {value!r}")
+    if not 0.0 <= ms <= 1000.0:
+        fail(f"--rolling-shutter must be between 0 and 1000 ms, got {value}")
+    return ms
+
+
+def readout(value: str | None, gyro: object, shutter: float | str = "auto") -> float | str | None:
+    """--readout-ms: a number of ms or 'auto'; rolling-shutter correction needs the gyro.
+    With a gyro, --rolling-shutter's number (or 'off': 0) stands for it."""
     if value is not None and not gyro:
-        fail("--readout-ms corrects the rolling shutter from the gyro: give --gyro LOG too")
+        fail(
+            "--readout-ms corrects the rolling shutter from the gyro: give --gyro LOG too "
+            "(without one, use --rolling-shutter)"
+        )
+    if gyro and shutter != "auto":
+        if value is not None:
+            fail("--readout-ms and --rolling-shutter both set the readout: give one")
+        return 0.0 if shutter == "off" else shutter
     if value is None or value == "auto":
         return value
     try:

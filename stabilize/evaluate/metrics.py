@@ -12,6 +12,9 @@
 * **Residual shake** (:mod:`stabilize.evaluate.shake`): the RMS of the high-passed
   frame-to-frame similarity motion, in px at the clip's width, and its in-plane rotation
   in degrees. What a viewer sees as shake; lower is steadier.
+* **Wobble** (:mod:`stabilize.evaluate.wobble`): the RMS of the shear and stretch between
+  consecutive frames (of the registration's linear part at the centre) that no
+  similarity has, in px at the clip's width: a rolling shutter's jello. Lower is better.
 
 Registrations are ORB features, spread evenly over a grid, matched with a ratio test,
 then a RANSAC homography; frames with too few features fall back to the identity (and are
@@ -27,7 +30,8 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.evaluate.shake import residual_shake, similarity_motion
+from stabilize.evaluate.shake import matched_points, residual_shake, similarity_motion
+from stabilize.evaluate.wobble import non_similar_part, wobble
 
 MIN_MATCHES = 12
 FEATURES = 2000  # ORB features per frame for registration
@@ -171,6 +175,7 @@ class ClipMetrics:
     registration_failures: int
     residual_shake_px: float  # stabilize.evaluate.shake: RMS of the high-passed 2-D motion
     residual_shake_deg: float
+    wobble_px: float  # stabilize.evaluate.wobble: RMS shear and stretch between frames
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -186,6 +191,7 @@ class _Clip:
         self.previous: tuple | None = None  # (features, grey) of the last frame
         self.frames = 0
         self.motions: list[NDArray] = []  # frame-to-frame similarities (dx, dy, dθ, d ln s)
+        self.skews: list[NDArray] = []  # their homographies' non-similar parts (wobble)
         self.shape: tuple[int, ...] = ()
 
     def add(self, frame: NDArray[np.uint8]):
@@ -194,8 +200,12 @@ class _Clip:
         grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         if self.previous is not None:
             self.inter.append(self.reg.homography(self.previous[0], feat))
-            motion = similarity_motion(self.previous[0], feat, self.reg.matcher)
+            matched = matched_points(self.previous[0], feat, self.reg.matcher)
+            motion = None if matched is None else similarity_motion(*matched)
             self.motions.append(np.zeros(4) if motion is None else motion)
+            if not np.array_equal(self.inter[-1], np.eye(3)):  # registered
+                centre = ((frame.shape[1] - 1) / 2, (frame.shape[0] - 1) / 2)
+                self.skews.append(non_similar_part(jacobian(self.inter[-1], centre)))
             self.itf.append(psnr(self.previous[1], grey))
         self.previous = (feat, grey)
         self.frames += 1
@@ -219,6 +229,7 @@ class _Clip:
             registration_failures=self.reg.failures,
             residual_shake_px=shake[0],
             residual_shake_deg=shake[1],
+            wobble_px=wobble(np.array(self.skews), w),
         )
 
 

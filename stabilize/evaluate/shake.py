@@ -27,11 +27,11 @@ CUTOFF_S = 0.5  # σ of the low-pass that separates intended motion from shake
 MIN_MATCHES = 12
 
 
-def similarity_motion(
+def matched_points(
     a: tuple[NDArray, NDArray | None], b: tuple[NDArray, NDArray | None], matcher
-) -> NDArray[np.float64] | None:
-    """(dx, dy, dθ, d ln s) of the similarity taking frame a's features to frame b's
-    (points in the frames' pixels, descriptors), or None where too few match."""
+) -> tuple[NDArray, NDArray] | None:
+    """The features of frame a and of frame b that match (points in the frames' pixels,
+    descriptors; ratio test), or None where too few do."""
     (pa, da), (pb, db) = a, b
     if da is None or db is None or len(pa) < MIN_MATCHES or len(pb) < MIN_MATCHES:
         return None
@@ -39,8 +39,12 @@ def similarity_motion(
     good = [m[0] for m in pairs if len(m) == 2 and m[0].distance < 0.8 * m[1].distance]
     if len(good) < MIN_MATCHES:
         return None
-    src = pa[[m.queryIdx for m in good]]
-    dst = pb[[m.trainIdx for m in good]]
+    return pa[[m.queryIdx for m in good]], pb[[m.trainIdx for m in good]]
+
+
+def similarity_motion(src: NDArray, dst: NDArray) -> NDArray[np.float64] | None:
+    """(dx, dy, dθ, d ln s) of the similarity taking matched points ``src`` to ``dst``
+    (RANSAC), or None where too few agree."""
     M, inliers = cv2.estimateAffinePartial2D(src, dst, method=cv2.RANSAC, ransacReprojThreshold=1.5)
     if M is None or inliers.sum() < MIN_MATCHES:
         return None

@@ -130,31 +130,41 @@ def estimate_motion(
     *,
     bands: int = 0,
     lens: Lens | None = None,
+    keep_samples: bool = False,
 ) -> tuple[VisualTrack, FocalChoice]:
     """Pass 1 with the focal length resolved: the track, and the focal length it was
-    estimated at (:class:`FocalChoice`)."""
+    estimated at (:class:`FocalChoice`); with ``keep_samples``, the track keeps its flow
+    vectors (they are kept while the focal length is estimated, and dropped after)."""
     choice = initial_focal(settings, info, lens)
     auto = choice.source in ("metadata", "default")  # nothing given: estimated
     at_start = replace(settings, focal=choice.px, fov=None)
     track = estimate_rotations(
-        path, info, at_start, progress, times, bands=bands, lens=lens, keep_samples=auto
+        path,
+        info,
+        at_start,
+        progress,
+        times,
+        bands=bands,
+        lens=lens,
+        keep_samples=auto or keep_samples,
     )
     if not auto:
         return track, choice
+    kept = (lambda t: t) if keep_samples else (lambda t: replace(t, samples=None))
     ws = flow.working_size(info.size)
     start = HoughEstimator(ws.size, choice.px * ws.scale[0])
     found = focal_from_track(track, start, info.width * ws.scale[0])
     if found is None:
         note = f"the clip's motion does not pin the focal length down: {choice.source} kept"
-        return replace(track, samples=None), replace(choice, note=note)
+        return kept(track), replace(choice, note=note)
     px = found / ws.scale[0]
     meta = choice.metadata_px
     if meta and abs(px / meta - 1) <= DISAGREES:  # agreed: the lens's own figure is finer
-        return replace(track, samples=None), replace(choice, estimated_px=px)
+        return kept(track), replace(choice, estimated_px=px)
     note = f"{100 * (px / meta - 1):+.0f}% off the metadata's (a digital zoom?)" if meta else ""
     estimator = HoughEstimator(ws.size, found, max_deg=settings.max_deg)
     again = estimate_again(estimator, track, bands)
-    return replace(again, samples=None), FocalChoice(px, info.width, "estimated", px, meta, note)
+    return kept(again), FocalChoice(px, info.width, "estimated", px, meta, note)
 
 
 def focal_from_track(track: VisualTrack, estimator: HoughEstimator, width: float) -> float | None:

@@ -80,8 +80,14 @@ def residual_motion(
     about the principal point, their flow u, v (n, M) where ``valid`` (n, M), rotations
     R (n, 3, 3), in pixels at focal length ``focal``."""
     lx, ly = landing(x, y, R, focal)
-    rx = (x + u) / focal - lx
-    ry = (y + v) / focal - ly
+    return background_similarity(x, y, (x + u) / focal - lx, (y + v) / focal - ly, valid, focal)
+
+
+def background_similarity(
+    x: NDArray, y: NDArray, rx: NDArray, ry: NDArray, valid: NDArray, focal: float
+) -> NDArray[np.float64]:
+    """The similarity (n, 4) of the remainders rx, ry (n, M, normalised) at points (x, y)
+    (M,, px about the principal point) that lie within ``GATE_PX`` of no motion."""
     near = valid & (np.hypot(rx, ry) < GATE_PX / focal)
     return fit_similarity(x / focal, y / focal, rx, ry, near, CAUCHY_PX / focal)
 

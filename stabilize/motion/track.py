@@ -10,7 +10,7 @@ the readout time can be estimated (:func:`stabilize.gyro.sync.estimate_readout`)
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -22,15 +22,23 @@ from rotation import RotationEstimate
 class Samples:
     """The flow vectors pass 1 read at the estimator's sample grid, kept (float32, about
     5 KB a pair) so that the rotations can be estimated again without decoding: with
-    another focal length (:mod:`stabilize.motion.focal`)."""
+    another focal length (:mod:`stabilize.motion.focal`), or what they leave measured
+    again once a rolling shutter's rows are dated (:mod:`stabilize.shutter.residual`)."""
 
     u: NDArray[np.float32]  # (N-1, M)
     v: NDArray[np.float32]
     valid: NDArray[np.bool_]
+    # the grid: (M,) points about the principal point and their rows, flow px
+    x: NDArray[np.float64] | None = None
+    y: NDArray[np.float64] | None = None
+    rows: NDArray[np.float64] | None = None
+    height: int = 0  # the flow field's, px
+    scale: float = 1.0  # flow px per input px (the estimator's focal is f·scale)
 
     def pairs(self, first: int, stop: int) -> Samples:
         """The pairs first..stop-1."""
-        return Samples(self.u[first:stop], self.v[first:stop], self.valid[first:stop])
+        part = slice(first, stop)
+        return replace(self, u=self.u[part], v=self.v[part], valid=self.valid[part])
 
 
 @dataclass(frozen=True)

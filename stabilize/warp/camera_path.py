@@ -1,8 +1,9 @@
 """The planned camera path of a clip, and how each of its frames is warped.
 
 A frame is warped by one homography, unless it must be warped by a map: through a lens
-profile, or row by row under a rolling shutter. On CUDA the plain homography warps of a
-batch run together (kornia); lens and rolling-shutter maps stay on the CPU.
+profile, or row by row under a rolling shutter. On CUDA the warps of a batch run
+together: homographies with kornia, maps with torch's grid_sample (their knots are
+computed on the CPU, a few thousand points a frame).
 """
 
 from __future__ import annotations
@@ -14,13 +15,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stabilize.video import i420
-from stabilize.warp.cuda import warp_frames_torch
+from stabilize.warp.cuda import remap_frames_torch, warp_frames_torch
 from stabilize.warp.frames import warp_frame
 from stabilize.warp.homography import homography
 from stabilize.warp.lens import Lens
 from stabilize.warp.planes import chroma_homography, remap_planes, warp_planes
-from stabilize.warp.remap import remap_from
-from stabilize.warp.sources import lens_source, rolling_source
+from stabilize.warp.remap import coarse_map, remap_from
+from stabilize.warp.sources import SourceMap, lens_source, rolling_source
 
 
 @dataclass
@@ -50,37 +51,61 @@ class CameraPath:
         C = self.smooth[frames] @ np.swapaxes(self.raw[frames], -1, -2)
         return C if self.shift is None else self.shift[frames] @ C
 
+    @property
+    def plain(self) -> bool:
+        """Whether every frame is warped by its homography alone (no lens, no rows)."""
+        return self.lens is None and self.row_corrections is None
+
     def warp_many(
         self, batch: Sequence[tuple[int, NDArray[np.uint8]]], device: str = "cpu"
     ) -> list[NDArray[np.uint8]]:
-        """Output frames of (k, frame) pairs, RGB or I420 (2-D); on CUDA the plain
-        homography warps run as one batch (lens and rolling-shutter maps stay on the CPU)."""
-        plain = self.lens is None and self.row_corrections is None
+        """Output frames of (k, frame) pairs, RGB or I420 (2-D); on CUDA the batch is
+        warped together (by homographies, or by the lens's or the rows' maps)."""
         eight_bit = all(frame.dtype == np.uint8 for _, frame in batch)
-        if not (device.startswith("cuda") and plain and eight_bit):
+        if not (device.startswith("cuda") and eight_bit):
             return [self.warp(k, frame) for k, frame in batch]
-        H = self.homographies[[k for k, _ in batch]]
+        return self.warp_together(batch, device)
+
+    def warp_together(
+        self, batch: Sequence[tuple[int, NDArray[np.uint8]]], device: str
+    ) -> list[NDArray[np.uint8]]:
+        """8-bit (k, frame) pairs warped as one batch with torch on ``device``."""
         frames = np.stack([frame for _, frame in batch])
+        ks = [k for k, _ in batch]
+        if self.plain:
+            H = self.homographies[ks]
+            Hc = np.array([chroma_homography(h) for h in H])
+
+            def warp(frames: NDArray, plane: int, fill: int) -> NDArray:
+                return warp_frames_torch(frames, Hc if plane else H, device, fill)
+        else:
+            h, w = frames.shape[1:3]
+            size = (h * 2 // 3, w) if frames.ndim == 3 else (h, w)  # I420: the luma's
+            coarse = np.stack([coarse_map(self.source(k), size) for k in ks])
+
+            def warp(frames: NDArray, plane: int, fill: int) -> NDArray:
+                return remap_frames_torch(frames, coarse, device, fill, half=plane > 0)
+
         if frames.ndim == 4:
-            return list(warp_frames_torch(frames, H, device))
+            return list(warp(frames, 0, 0))
         planes = [np.stack(p) for p in zip(*(i420.split(f) for f in frames), strict=True)]
-        Hc = np.array([chroma_homography(h) for h in H])
-        warped = [
-            warp_frames_torch(p, M, device, fill)
-            for p, M, fill in zip(planes, (H, Hc, Hc), i420.black(frames), strict=True)
-        ]
+        fills = i420.black(frames)
+        warped = [warp(p, i, fill) for i, (p, fill) in enumerate(zip(planes, fills, strict=True))]
         return [i420.join(*parts) for parts in zip(*warped, strict=True)]
+
+    def source(self, k: int) -> SourceMap:
+        """Frame k's map from output to input pixels, through the lens or row by row."""
+        rolling = self.row_corrections is not None
+        C = self.row_corrections[k] if rolling else self.corrections(k)
+        if self.lens is not None:
+            return lens_source(self.lens, C, self.zoom[k], self.knot_rows)
+        return rolling_source(homography(self.K, C, self.zoom[k]), self.knot_rows)
 
     def warp(self, k: int, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
         """Frame k of the output, from frame k of the input (RGB, or I420 when 2-D)."""
         planar = frame.ndim == 2
-        rolling = self.row_corrections is not None
-        if self.lens is None and not rolling:
+        if self.plain:
             H = self.homographies[k]
             return warp_planes(frame, H) if planar else warp_frame(frame, H)
-        C = self.row_corrections[k] if rolling else self.corrections(k)
-        if self.lens is not None:
-            source = lens_source(self.lens, C, self.zoom[k], self.knot_rows)
-        else:
-            source = rolling_source(homography(self.K, C, self.zoom[k]), self.knot_rows)
+        source = self.source(k)
         return remap_planes(frame, source) if planar else remap_from(frame, source)

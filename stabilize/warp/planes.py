@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 
 from stabilize.video.i420 import black, join, split
 from stabilize.warp.frames import resize_image
-from stabilize.warp.remap import remap_from
+from stabilize.warp.remap import MAP_STEP, coarse_map, dense_map, half_knots, remap_with
 from stabilize.warp.sources import SourceMap
 
 HALF = np.array([[0.5, 0.0, -0.25], [0.0, 0.5, -0.25], [0.0, 0.0, 1.0]])  # S above
@@ -42,15 +42,12 @@ def remap_planes(frame: NDArray, source: SourceMap) -> NDArray:
     """Warp every plane by a map ``source`` (full-size output pixels → input pixels);
     chroma sees the same map through the half-size coordinates."""
     y, u, v = split(frame)
-
-    def chroma_source(pts: NDArray) -> NDArray:
-        return (source(2.0 * pts + 0.5) + 0.5) / 2.0 - 0.5
-
+    coarse = coarse_map(source, y.shape)
+    dense = dense_map(coarse, y.shape)
+    half = dense_map(half_knots(coarse), u.shape, MAP_STEP // 2)
     fill = black(frame)
     return join(
-        remap_from(y, source, fill[0]),
-        remap_from(u, chroma_source, fill[1]),
-        remap_from(v, chroma_source, fill[2]),
+        remap_with(y, dense, fill[0]), remap_with(u, half, fill[1]), remap_with(v, half, fill[2])
     )
 
 

@@ -75,6 +75,11 @@ CASES = {
     "size tiny": Case(("--size", "8x8"), 2),
     "readout without gyro": Case(("--readout-ms", "5"), 2),
     "readout not a number": Case(("--gyro", str(LOG), "--readout-ms", "fast"), 2),
+    "rolling shutter not a number": Case(("--rolling-shutter", "fast"), 2),
+    "rolling shutter too long": Case(("--rolling-shutter", "2000"), 2),
+    "rolling shutter and readout": Case(
+        ("--gyro", str(LOG), "--readout-ms", "5", "--rolling-shutter", "5"), 2
+    ),
     "gyro log missing": Case(("--gyro", "{dir}/nope.csv"), 2),
     "gyro log empty": Case(("--gyro", "{dir}/empty.csv"), 2, files={"empty.csv": ""}),
     "gyro log garbage": Case(("--gyro", "{dir}/g.csv"), 2, files={"g.csv": "1,2\n3\n"}),

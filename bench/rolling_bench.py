@@ -1,0 +1,95 @@
+"""Rolling shutter without a gyro: the readout found from the video, and the wobble left.
+
+Rendered street clips (540×960, 4 s, 3° RMS shake: 1–3° a frame) with readouts of 0, 15,
+25 and 33 ms are stabilised twice, with ``--rolling-shutter auto`` (the default) and
+``off``, at the true field of view; the table gives the readout found, its uncertainty,
+the residual shake and the wobble (``stabilize evaluate``) of each output, and the
+wobble's ratio. phone-cc9's frames, whose gyro gives a 25.4 ms readout
+(``stabilize compare``), are run at their focal length, 573.85 px.
+
+    python bench/rolling_bench.py
+    python bench/rolling_bench.py --readouts 25 --seconds 2
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from stabilize.evaluate.metrics import evaluate_pair
+from stabilize.synth import SynthOptions, render_clip
+from stabilize.video import ffmpeg_exe, probe, read_frames
+
+PHONE = Path(__file__).resolve().parents[2] / "shared" / "data" / "phone-cc9" / "frames"
+PHONE_FOCAL = "573.85"
+
+
+def stabilise(clip: Path, out: Path, shutter: str, lens: list[str]) -> tuple[dict, float]:
+    """Our run's summary and wall time."""
+    cmd = [sys.executable, "-m", "stabilize.cli", "run", str(clip), str(out), "-q", "--json"]
+    start = time.perf_counter()
+    done = subprocess.run(
+        [*cmd, "--overwrite", "--rolling-shutter", shutter, *lens],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
+    return json.loads(done.stdout), time.perf_counter() - start
+
+
+def phone_clip(work: Path) -> Path:
+    clip = work / "phone-cc9.mp4"
+    pattern = ["-framerate", "30", "-start_number", "99", "-i", str(PHONE / "RE_frame-%d.jpg")]
+    cmd = [ffmpeg_exe(), "-v", "error", "-y", *pattern, "-c:v", "libx264", "-crf", "12"]
+    subprocess.run([*cmd, "-pix_fmt", "yuv420p", str(clip)], check=True)
+    return clip
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--readouts", type=float, nargs="*", default=[0.0, 15.0, 25.0, 33.0])
+    parser.add_argument("--seconds", type=float, default=4.0)
+    args = parser.parse_args()
+    work = Path(tempfile.mkdtemp(prefix="rolling-bench-"))
+    runs = []
+    for ms in args.readouts:
+        folder = work / f"rs{ms:g}"
+        opts = SynthOptions(
+            seed=7 + int(ms), seconds=args.seconds, shake_deg=3.0, rolling_shutter_ms=ms
+        )
+        render_clip(folder, opts)
+        runs.append((f"rendered, {ms:g} ms", folder / "clip.mp4", ["--fov", str(opts.hfov)]))
+    if PHONE.is_dir():
+        runs.append(("phone-cc9 (gyro: 25.4 ms)", phone_clip(work), ["--focal", PHONE_FOCAL]))
+    print(
+        f"{'clip':28s}{'readout found':>24s}{'shake auto/off':>17s}{'wobble auto/off':>18s}"
+        f"{'ratio':>7s}{'s auto/off':>13s}"
+    )
+    for name, clip, lens in runs:
+        info = probe(clip)
+        found, seconds, metrics = None, [], []
+        for shutter in ("auto", "off"):
+            out = work / f"{clip.parent.name}-{clip.stem}-{shutter}.mp4"
+            summary, t = stabilise(clip, out, shutter, lens)
+            found = found or summary["rolling_shutter"]
+            seconds.append(t)
+            _, after = evaluate_pair(read_frames(clip, info=info), read_frames(out, info.size))
+            metrics.append(after)
+        estimate = found["estimate_ms"]
+        told = "-" if estimate is None else f"{estimate:.1f} ± {found['stderr_ms']:.1f} ms"
+        told = f"{told} ({found['source']}{', used' if found['readout_ms'] else ''})"
+        (a, b), (wa, wb) = ((m.residual_shake_px for m in metrics), (m.wobble_px for m in metrics))
+        print(
+            f"{name:28s}{told:>24s}{a:>9.3f}/{b:<7.3f}{wa:>10.3f}/{wb:<7.3f}{wa / wb:>7.2f}"
+            f"{seconds[0]:>7.1f}/{seconds[1]:<5.1f}"
+        )
+    print(f"\noutputs in {work}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,70 @@
+"""The image motion a rotation leaves, measured again once the rows are dated.
+
+Pass 1 measured each pair's remaining similarity against the whole-frame rotation, on
+flow skewed by the rolling shutter (:mod:`stabilize.motion.residual`): part of that skew
+went into the similarity, which the row corrections then undo a second time. With the
+turns D_k(y) of each frame's rows against its middle row, every kept flow vector is
+taken to the middle rows' cameras first: a point seen at row y of frame k, ray p, and at
+row y' of frame k+1, ray p', leaves
+
+    r = π(D_{k+1}(y')ᵀ p') - π(R_k D_k(y)ᵀ p),
+
+with R_k the turn between the middle rows, and the background's similarity is fitted to
+that, as in pass 1.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from stabilize.motion.residual import background_similarity
+from stabilize.motion.track import Samples
+from stabilize.warp.rolling import RollingShutter
+
+CHUNK = 16  # pairs whose per-vector turns are held at once
+
+
+def rectified_residual(
+    samples: Samples, R: NDArray, rolling: RollingShutter, focal: float, height: int
+) -> NDArray[np.float64]:
+    """The similarity (N-1, 4) each middle-row rotation R (N-1, 3, 3) leaves, from the
+    kept ``samples``; ``focal`` (px) and ``height`` (px) of the input frames."""
+    f = focal * samples.scale
+    x, y = samples.x, samples.y
+    ray = np.stack([x, y, np.full_like(x, f)], 1)
+    to_input = height / samples.height  # flow rows → input rows (pixel centres)
+    out = []
+    for first in range(0, len(samples.u), CHUNK):
+        part = slice(first, first + CHUNK)
+        u, v = samples.u[part].astype(np.float64), samples.v[part].astype(np.float64)
+        k = np.arange(first, first + len(u))
+        start = turns_at(rolling, k, (samples.rows + 0.5) * to_input - 0.5)
+        end = turns_at(rolling, k + 1, (samples.rows + v + 0.5) * to_input - 0.5)
+        seen = np.stack([x + u, y + v, np.full_like(u, f)], -1)
+        before = (start.swapaxes(-1, -2) @ ray[..., None])[..., 0]  # D_k(y)ᵀ p
+        after = (end.swapaxes(-1, -2) @ seen[..., None])[..., 0]  # D_{k+1}(y')ᵀ p'
+        turned = (R[part][:, None] @ before[..., None])[..., 0]
+        rx = _x(after) - _x(turned)
+        ry = _y(after) - _y(turned)
+        out.append(background_similarity(x, y, rx, ry, samples.valid[part], f))
+    return np.concatenate(out) if out else np.zeros((0, 4))
+
+
+def turns_at(rolling: RollingShutter, frames: NDArray, rows: NDArray) -> NDArray[np.float64]:
+    """D_k(y) (n, M, 3, 3) of ``frames`` (n,) at input ``rows`` ((M,) or (n, M)),
+    linear between the knot rows (the turns between knots are tiny)."""
+    knots = rolling.rows
+    rows = np.broadcast_to(np.clip(rows, knots[0], knots[-1]), (len(frames), np.shape(rows)[-1]))
+    i = np.clip(np.searchsorted(knots, rows) - 1, 0, len(knots) - 2)
+    frac = ((rows - knots[i]) / (knots[i + 1] - knots[i]))[..., None, None]
+    stack = rolling.turns[frames[:, None], i]
+    return stack + frac * (rolling.turns[frames[:, None], i + 1] - stack)
+
+
+def _x(p: NDArray) -> NDArray:
+    return p[..., 0] / np.maximum(p[..., 2], 1e-9)
+
+
+def _y(p: NDArray) -> NDArray:
+    return p[..., 1] / np.maximum(p[..., 2], 1e-9)

@@ -1,0 +1,50 @@
+"""The readout from band rotations alone: recovered, refused, or a global shutter."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from stabilize.shutter.readout import estimate_readout, readout_for
+from tests.stabilize.shutter.helpers import banded_track
+
+
+@pytest.mark.parametrize("ms", [15.0, 25.0, 33.0])
+def test_the_readout_is_recovered_from_the_bands(ms):
+    track, _ = banded_track(ms / 1000.0, seed=int(ms))
+    found, spline = estimate_readout(track)
+    assert found.source == "estimated" and spline is not None
+    assert found.seconds == pytest.approx(ms / 1000.0, abs=5e-4)
+    assert 0 < found.stderr < 1e-3
+
+
+def test_a_global_shutter_is_measured_as_none():
+    track, _ = banded_track(0.0, seed=3)
+    found, spline = estimate_readout(track)
+    assert found.seconds == 0.0 and spline is None and found.source == "estimated"
+    assert abs(found.estimate) < 1e-3
+    assert "global shutter" in found.describe()
+
+
+def test_smooth_slow_motion_is_refused():
+    # A pan with no shake: every band sees the same turn whatever the readout is.
+    track, _ = banded_track(0.025, shake_deg=0.0, noise_deg=0.05, seed=4)
+    found, spline = estimate_readout(track)
+    assert found.source == "refused" and found.seconds == 0.0 and spline is None
+    assert "pin" in found.reason
+
+
+def test_too_few_textured_bands_are_refused():
+    track, _ = banded_track(0.025, seed=5)
+    bare = replace(track, band_support=np.zeros_like(track.band_support))
+    found, _ = estimate_readout(bare)
+    assert found.source == "refused" and "texture" in found.reason
+
+
+def test_off_and_a_given_readout_are_kept():
+    track, _ = banded_track(0.025, seed=6)
+    off, none = readout_for("off", track)
+    assert (off.seconds, off.source, none) == (0.0, "off", None)
+    given, spline = readout_for(20.0, track)
+    assert (given.seconds, given.source) == (0.02, "given") and spline is not None
+    assert given.summary()["readout_ms"] == pytest.approx(20.0)

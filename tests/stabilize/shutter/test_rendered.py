@@ -1,0 +1,61 @@
+"""Rendered rolling-shutter clips: the readout found from the video alone, the jello
+undone, and a global-shutter clip left as it was."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from stabilize import Settings, stabilize_video
+from stabilize.evaluate.metrics import evaluate_pair
+from stabilize.synth import SynthOptions, render_clip
+from stabilize.video import probe, read_frames
+
+SIZE = (270, 480)
+
+
+def rendered(folder: Path, readout_ms: float) -> Path:
+    opts = SynthOptions(
+        size=SIZE, seconds=2.5, seed=21, shake_deg=3.0, crowd=4, rolling_shutter_ms=readout_ms
+    )
+    render_clip(folder, opts)
+    return folder / "clip.mp4"
+
+
+def wobble(original: Path, output: Path) -> float:
+    info = probe(original)
+    _, after = evaluate_pair(read_frames(original, info=info), read_frames(output, info.size))
+    return after.wobble_px
+
+
+@pytest.fixture(scope="module")
+def jello(tmp_path_factory) -> Path:
+    return rendered(tmp_path_factory.mktemp("jello"), 25.0)
+
+
+def test_the_readout_is_found_and_the_wobble_undone(jello, tmp_path):
+    settings = Settings(fov=70.0, max_zoom=1.3)
+    summary, planned = stabilize_video(jello, tmp_path / "auto.mp4", settings)
+    found = summary["rolling_shutter"]
+    assert found["source"] == "estimated" and found["readout_ms"] == pytest.approx(25.0, abs=2.5)
+    assert planned.row_corrections is not None
+    off = Settings(fov=70.0, max_zoom=1.3, rolling_shutter="off")
+    summary_off, planned_off = stabilize_video(jello, tmp_path / "off.mp4", off)
+    assert summary_off["rolling_shutter"]["source"] == "off"
+    assert planned_off.row_corrections is None
+    corrected, uncorrected = (
+        wobble(jello, tmp_path / "auto.mp4"),
+        wobble(jello, tmp_path / "off.mp4"),
+    )
+    assert corrected < 0.4 * uncorrected
+
+
+def test_a_global_shutter_clip_is_left_alone(tmp_path):
+    clip = rendered(tmp_path / "global", 0.0)
+    summary, planned = stabilize_video(clip, tmp_path / "auto.mp4", Settings(fov=70.0))
+    assert summary["rolling_shutter"]["readout_ms"] == 0.0
+    assert planned.row_corrections is None
+    _, plain = stabilize_video(
+        clip, tmp_path / "off.mp4", Settings(fov=70.0, rolling_shutter="off")
+    )
+    np.testing.assert_allclose(planned.homographies, plain.homographies)
