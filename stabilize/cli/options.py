@@ -214,14 +214,23 @@ def flow_settings(flow_name: str, raft_weights: Path | None, device: str, **opti
 
 def field_of_view(text: str | None) -> float | str | None:
     """--fov: degrees across, between 1 and 179, or 'auto'."""
-    if text is None or text == "auto":
+    return None if text is None else number_or_word(text, "--fov", ("auto",), (1.0, 179.0), "°")
+
+
+def number_or_word(
+    text: str, option: str, words: tuple[str, ...], bounds: tuple[float, float], unit: str
+) -> float | str:
+    """An option that takes one of ``words`` or a number within ``bounds``."""
+    if text in words:
         return text
+    lo, hi = bounds
+    choices = " or ".join(repr(w) for w in words)
     try:
         value = float(text)
     except ValueError:
-        fail(f"--fov takes degrees (1–179) or 'auto', got {text!r}")
-    if not 1.0 <= value <= 179.0:
-        fail(f"--fov must be between 1 and 179 degrees, got {text}")
+        fail(f"{option} takes a number ({lo:g}–{hi:g} {unit}) or {choices}, got {text!r}")
+    if not lo <= value <= hi:
+        fail(f"{option} must be between {lo:g} and {hi:g} {unit}, got {text}")
     return value
 
 
@@ -240,17 +249,9 @@ def output_size(text: str | None) -> tuple[int, int] | None:
     return h, w
 
 
-def rolling_shutter(value: str | float) -> float | str:
+def rolling_shutter(value: str) -> float | str:
     """--rolling-shutter: 'auto', 'off', or a readout of 0..1000 ms."""
-    if value in ("auto", "off"):
-        return value
-    try:
-        ms = float(value)
-    except ValueError:
-        fail(f"--rolling-shutter takes 'auto', 'off' or a number of ms, got {value!r}")
-    if not 0.0 <= ms <= 1000.0:
-        fail(f"--rolling-shutter must be between 0 and 1000 ms, got {value}")
-    return ms
+    return number_or_word(str(value), "--rolling-shutter", ("auto", "off"), (0.0, 1000.0), "ms")
 
 
 def readout(value: str | None, gyro: object, shutter: float | str = "auto") -> float | str | None:

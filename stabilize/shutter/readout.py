@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from stabilize.gyro.sync import golden_section
 from stabilize.motion.track import VisualTrack
 from stabilize.shutter.attitude import Bands, Spline, fit_attitude, knots_for
 
@@ -142,21 +143,3 @@ def curvature_stderr(bands: Bands, r: float, knots: NDArray, scale: float, h: fl
     if curvature <= 0:
         return float("inf")
     return float(np.sqrt((q0 / dof) / (0.5 * curvature)))
-
-
-def golden_section(cost, lo: float, hi: float, tol: float) -> float:
-    """The minimiser of a unimodal ``cost`` on [lo, hi]."""
-    ratio = (np.sqrt(5.0) - 1.0) / 2.0
-    a, b = lo, hi
-    c, d = b - ratio * (b - a), a + ratio * (b - a)
-    fc, fd = cost(c), cost(d)
-    while b - a > tol:
-        if fc < fd:
-            b, d, fd = d, c, fc
-            c = b - ratio * (b - a)
-            fc = cost(c)
-        else:
-            a, c, fc = c, d, fd
-            d = a + ratio * (b - a)
-            fd = cost(d)
-    return 0.5 * (a + b)

@@ -71,3 +71,18 @@ def test_registration_survives_featureless_frames():
     blank = [np.full((90, 160, 3), 128, np.uint8)] * 10
     _, m = evaluate_pair(blank, blank)
     assert m.cropping_ratio == 1.0 and m.registration_failures > 0
+
+
+def test_the_wobble_is_the_shear_between_frames_in_pixels(shaken):
+    # Frames sheared by 0, s, 0, s, ...: x moves by s·(y - centre); each frame-to-frame
+    # homography's non-similar part is then s/2 (half the shear is a rotation), so the
+    # wobble is s/2 · w/2. A turning global-shutter camera (the shaken clip) scores about
+    # 0, up to the registration's noise at this size.
+    frame = shaken[0]
+    h, w = frame.shape[:2]
+    s = 0.02
+    shear = np.array([[1.0, s, -s * (h - 1) / 2], [0.0, 1.0, 0.0]])
+    sheared = cv2.warpAffine(frame, shear, (w, h), flags=cv2.INTER_LINEAR)
+    jello = [(frame if k % 2 else sheared)[16:-16, 16:-16] for k in range(30)]
+    assert evaluate(jello).wobble_px == pytest.approx(s / 2 * (w - 32) / 2, rel=0.15)
+    assert evaluate(shaken).wobble_px < 0.25 * evaluate(jello).wobble_px  # noise at 320 px
