@@ -20,11 +20,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from rotation import so3
 from stabilize.gyro.sync import golden_section
 from stabilize.motion.track import VisualTrack
 from stabilize.shutter.attitude import Bands, Spline, fit_attitude, knots_for
 
 GRID = 29  # readouts tried across -0.2..1.2 frame intervals
+MAX_SEARCH_PAIRS = 900  # pairs the readout is searched on (30 s at 30 fps)
 MIN_PAIRS = 20  # pairs with three usable bands, fewest that date the rows
 MAX_STDERR = 0.06  # of a frame interval (2 ms at 30 fps): a less certain readout is refused
 SIGNIFICANT = 3.0  # an estimate within this many σ of 0, or under MIN_READOUT, is 0
@@ -88,14 +90,18 @@ def readout_for(option: float | str, track: VisualTrack) -> tuple[Readout, Splin
 
 def estimate_readout(track: VisualTrack) -> tuple[Readout, Spline | None]:
     """The readout of a track with band rotations, and the attitude fitted at it (None
-    where refused or 0)."""
+    where refused or 0). A long clip's readout is searched on its ``MAX_SEARCH_PAIRS``
+    most shaking consecutive pairs (the search's time grows with the length: 1.5 s for a
+    minute), and the attitude is then fitted to the whole clip once."""
     frame = float(np.median(np.diff(track.times)))
-    bands = Bands.of(track)
-    per_pair = bands.usable.reshape(len(track.bands), -1).sum(0)
+    first = _most_shaking(track, MAX_SEARCH_PAIRS)
+    searched = track.pairs(first, first + MAX_SEARCH_PAIRS) if first is not None else track
+    bands = Bands.of(searched)
+    per_pair = bands.usable.reshape(len(searched.bands), -1).sum(0)
     if int((per_pair >= 3).sum()) < MIN_PAIRS:
         reason = "too few frames with texture across their height"
         return Readout(0.0, "refused", reason=reason), None
-    knots = knots_for(track.times)
+    knots = knots_for(searched.times)
     scale = cauchy_scale(bands, 0.5 * frame, knots)
 
     def cost(r: float) -> float:
@@ -107,7 +113,19 @@ def estimate_readout(track: VisualTrack) -> tuple[Readout, Spline | None]:
     step = grid[1] - grid[0]
     r = golden_section(cost, grid[max(best - 1, 0)], grid[min(best + 1, GRID - 1)], 1e-2 * step)
     stderr = curvature_stderr(bands, r, knots, scale, 0.05 * frame)
+    if first is not None:  # the attitude of the whole clip
+        bands, knots = Bands.of(track), knots_for(track.times)
+        scale = cauchy_scale(bands, r, knots)
     return decide(bands, r, stderr, frame, knots, scale)
+
+
+def _most_shaking(track: VisualTrack, n: int) -> int | None:
+    """The first of the n consecutive pairs whose rotations change the most from pair to
+    pair (what dates the bands), or None for a track of no more pairs than that."""
+    if len(track.rotations) <= n:
+        return None
+    change = np.linalg.norm(np.diff(so3.log_so3(track.rotations), axis=0), axis=1)
+    return int(np.argmax(np.convolve(change, np.ones(n - 1), mode="valid")))
 
 
 def cauchy_scale(bands: Bands, readout: float, knots: NDArray) -> float:
@@ -122,8 +140,11 @@ def decide(
     """Refuse an uncertain or impossible readout, call a negligible one 0."""
     if not stderr <= MAX_STDERR * frame:
         return Readout(0.0, "refused", r, stderr, "the motion does not pin it down"), None
-    if not -0.1 * frame < r < 1.05 * frame:
+    if r >= 1.05 * frame:
         return Readout(0.0, "refused", r, stderr, "longer than a frame interval"), None
+    if r <= -0.1 * frame:
+        reason = "negative: a bottom-to-top readout is not modelled"
+        return Readout(0.0, "refused", r, stderr, reason), None
     if r < max(SIGNIFICANT * stderr, MIN_READOUT):
         return Readout(0.0, "estimated", r, stderr, "no rolling shutter measured"), None
     spline, _, _ = fit_attitude(bands, r, knots, scale)

@@ -48,3 +48,13 @@ def test_off_and_a_given_readout_are_kept():
     given, spline = readout_for(20.0, track)
     assert (given.seconds, given.source) == (0.02, "given") and spline is not None
     assert given.summary()["readout_ms"] == pytest.approx(20.0)
+
+
+def test_a_long_clip_is_searched_on_its_most_shaking_stretch(monkeypatch):
+    import stabilize.shutter.readout as readout
+
+    monkeypatch.setattr(readout, "MAX_SEARCH_PAIRS", 40)
+    track, _ = banded_track(0.025, seconds=4.0, seed=12)
+    found, spline = readout.estimate_readout(track)
+    assert found.seconds == pytest.approx(0.025, abs=1e-3)
+    assert spline.knots[-1] > track.times[-1]  # the attitude spans the whole clip
