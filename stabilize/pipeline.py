@@ -89,25 +89,8 @@ def stabilize_video(
         tell(notice)
     start = time.perf_counter()
     bar = progress or (lambda label, total: no_progress)
-    bands = READOUT_BANDS if dates_rows(settings) else 0
-    estimating = bar("estimating", max(len(job.times) - 1, 0))
-    track, focal = estimate_motion(
-        src,
-        job.info,
-        settings,
-        estimating,
-        job.times,
-        bands=bands,
-        lens=job.lens,
-        keep_samples=bands > 0 and job.log is None,  # measured again once rows are dated
-    )
-    if focal.note:
-        tell(f"focal length: {focal.note}")
-    R, rolling, residual, repaired, gyro_summary, shutter = _rotations(
-        settings, job, track, focal.px
-    )
-    if shutter is not None and shutter.source != "off":
-        tell(f"rolling shutter: {shutter.describe()}")
+    track, focal, rotations = _motion(src, job, settings, bar, tell)
+    R, rolling, residual, repaired, gyro_summary, shutter = rotations
     t_estimate = time.perf_counter() - start
     K = _camera_matrix(focal.px, job.info, job.lens)
     planned = plan_path(
@@ -191,6 +174,30 @@ def dates_rows(settings: Settings) -> bool:
     if settings.gyro:
         return settings.readout_ms == "auto"
     return settings.rolling_shutter not in ("off", 0, 0.0)
+
+
+def _motion(src: Path, job: Job, settings: Settings, bar, tell) -> tuple:
+    """(track, focal length, :func:`_rotations`): pass 1, with its notices."""
+    bands = READOUT_BANDS if dates_rows(settings) else 0
+    keep = bands > 0 and job.log is None  # the vectors, measured again once rows are dated
+    estimating = bar("estimating", max(len(job.times) - 1, 0))
+    track, focal = estimate_motion(
+        src,
+        job.info,
+        settings,
+        estimating,
+        job.times,
+        bands=bands,
+        lens=job.lens,
+        keep_samples=keep,
+    )
+    if focal.note:
+        tell(f"focal length: {focal.note}")
+    rotations = _rotations(settings, job, track, focal.px)
+    shutter = rotations[-1]
+    if shutter is not None and shutter.source != "off":
+        tell(f"rolling shutter: {shutter.describe()}")
+    return track, focal, rotations
 
 
 def _rotations(settings: Settings, job: Job, track: VisualTrack, focal: float) -> tuple:
