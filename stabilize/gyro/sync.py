@@ -25,14 +25,13 @@ from numpy.typing import NDArray
 from rotation import so3
 from stabilize.gyro.axes import signed_permutations
 from stabilize.gyro.log import GyroError, GyroLog
-from stabilize.motion.track import VisualTrack
+from stabilize.motion.track import MIN_BAND_SUPPORT, VisualTrack
 
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 MIN_CORRELATION = 0.6  # of angular speeds, below which a log does not match the video
 MIN_COVERAGE = 0.8  # share of the frame pairs the log must cover (camera logs stop early)
 MAX_DRIFT = 2e-3  # clock-rate difference searched with fit_drift (crystals: ~1e-5..1e-4)
 MAX_READOUT_STDERR = 0.15  # of a frame interval: a less certain readout is not used
-MIN_BAND_SUPPORT = 0.05  # a band with so few agreeing vectors says little about its time
 
 
 @dataclass(frozen=True)

@@ -68,9 +68,13 @@ def landing(x: NDArray, y: NDArray, R: NDArray, focal: float) -> tuple[NDArray, 
     """Where rotations R (n, 3, 3) put points (x, y) (M,) about the principal point, in
     pixels at ``focal``: π(R (x, y, f)) in normalised coordinates, (n, M) each."""
     rays = np.stack([x, y, np.full_like(x, focal)], 1)
-    turned = rays @ np.swapaxes(np.asarray(R, np.float64), -1, -2)  # (n, M, 3)
-    z = np.maximum(turned[..., 2], 1e-9)
-    return turned[..., 0] / z, turned[..., 1] / z
+    return normalised(rays @ np.swapaxes(np.asarray(R, np.float64), -1, -2))  # (n, M, 3)
+
+
+def normalised(rays: NDArray) -> tuple[NDArray, NDArray]:
+    """π(p): the normalised image coordinates (x/z, y/z) of rays (..., 3)."""
+    z = np.maximum(rays[..., 2], 1e-9)
+    return rays[..., 0] / z, rays[..., 1] / z
 
 
 def residual_motion(

@@ -17,6 +17,8 @@ from numpy.typing import NDArray
 
 from rotation import RotationEstimate
 
+MIN_BAND_SUPPORT = 0.05  # a band with so few agreeing vectors says little about its time
+
 
 @dataclass(frozen=True)
 class Samples:

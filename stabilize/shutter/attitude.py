@@ -28,9 +28,8 @@ from scipy.sparse.linalg import spsolve
 from rotation import so3
 from stabilize.gyro.integrate import Attitude, attitude
 from stabilize.gyro.log import GyroLog
-from stabilize.motion.track import VisualTrack
+from stabilize.motion.track import MIN_BAND_SUPPORT, VisualTrack
 
-MIN_BAND_SUPPORT = 0.05  # a band with fewer agreeing vectors is not used
 BEND = 1e-3  # weight of the coefficients' second differences (rad², against the data's)
 IRLS_STEPS = 3
 RATE_SAMPLES = 8  # rate samples per frame interval handed to the integration

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.motion.residual import background_similarity
+from stabilize.motion.residual import background_similarity, normalised
 from stabilize.motion.track import Samples
 from stabilize.warp.rolling import RollingShutter
 
@@ -39,32 +39,12 @@ def rectified_residual(
         part = slice(first, first + CHUNK)
         u, v = samples.u[part].astype(np.float64), samples.v[part].astype(np.float64)
         k = np.arange(first, first + len(u))
-        start = turns_at(rolling, k, (samples.rows + 0.5) * to_input - 0.5)
-        end = turns_at(rolling, k + 1, (samples.rows + v + 0.5) * to_input - 0.5)
+        start = rolling.at(k, (samples.rows + 0.5) * to_input - 0.5)
+        end = rolling.at(k + 1, (samples.rows + v + 0.5) * to_input - 0.5)
         seen = np.stack([x + u, y + v, np.full_like(u, f)], -1)
         before = (start.swapaxes(-1, -2) @ ray[..., None])[..., 0]  # D_k(y)ᵀ p
         after = (end.swapaxes(-1, -2) @ seen[..., None])[..., 0]  # D_{k+1}(y')ᵀ p'
         turned = (R[part][:, None] @ before[..., None])[..., 0]
-        rx = _x(after) - _x(turned)
-        ry = _y(after) - _y(turned)
-        out.append(background_similarity(x, y, rx, ry, samples.valid[part], f))
+        (ax, ay), (tx, ty) = normalised(after), normalised(turned)
+        out.append(background_similarity(x, y, ax - tx, ay - ty, samples.valid[part], f))
     return np.concatenate(out) if out else np.zeros((0, 4))
-
-
-def turns_at(rolling: RollingShutter, frames: NDArray, rows: NDArray) -> NDArray[np.float64]:
-    """D_k(y) (n, M, 3, 3) of ``frames`` (n,) at input ``rows`` ((M,) or (n, M)),
-    linear between the knot rows (the turns between knots are tiny)."""
-    knots = rolling.rows
-    rows = np.broadcast_to(np.clip(rows, knots[0], knots[-1]), (len(frames), np.shape(rows)[-1]))
-    i = np.clip(np.searchsorted(knots, rows) - 1, 0, len(knots) - 2)
-    frac = ((rows - knots[i]) / (knots[i + 1] - knots[i]))[..., None, None]
-    stack = rolling.turns[frames[:, None], i]
-    return stack + frac * (rolling.turns[frames[:, None], i + 1] - stack)
-
-
-def _x(p: NDArray) -> NDArray:
-    return p[..., 0] / np.maximum(p[..., 2], 1e-9)
-
-
-def _y(p: NDArray) -> NDArray:
-    return p[..., 1] / np.maximum(p[..., 2], 1e-9)

@@ -27,3 +27,19 @@ class RollingShutter:
         """Per-row corrections C_k D_k(y_b)ᵀ (N, B, 3, 3) of the ``frames``' corrections
         C (N, 3, 3)."""
         return C[:, None] @ np.swapaxes(self.turns[frames], -1, -2)
+
+    def at(self, frames: NDArray, rows: NDArray) -> NDArray[np.float64]:
+        """D_k(y) (n, M, 3, 3) of ``frames`` (n,) at input ``rows`` ((M,) or (n, M)),
+        linear between the knot rows (the turns between knots are tiny)."""
+        rows = np.broadcast_to(rows, (len(frames), np.shape(rows)[-1]))
+        k, frac = between_knots(self.rows, rows)
+        below = self.turns[frames[:, None], k]
+        return below + frac[..., None, None] * (self.turns[frames[:, None], k + 1] - below)
+
+
+def between_knots(knots: NDArray, y: NDArray) -> tuple[NDArray, NDArray]:
+    """For rows ``y`` (any shape; clipped to the knots' span), the index k of the knot at
+    or above each and the fraction of the way to knot k + 1."""
+    y = np.clip(y, knots[0], knots[-1])
+    k = np.clip(np.searchsorted(knots, y) - 1, 0, len(knots) - 2)
+    return k, (y - knots[k]) / (knots[k + 1] - knots[k])

@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 
 from stabilize.warp.homography import inverses
 from stabilize.warp.lens import Lens, project, unproject
+from stabilize.warp.rolling import between_knots
 
 ROW_ITERATIONS = 2  # fixed-point steps for an output pixel's source row
 
@@ -90,11 +91,9 @@ def through_rows(stack: NDArray, rows: NDArray | None, linear, finish) -> NDArra
     flat = images.reshape(-1, 3)  # a point's knots are b rows apart: one flat gather
     first = (np.arange(m * n) * b).reshape(m, n)
     for _ in range(ROW_ITERATIONS):
-        y = np.clip(np.nan_to_num(src[..., 1], nan=rows[0]), rows[0], rows[-1])
-        k = np.clip(np.searchsorted(rows, y) - 1, 0, len(rows) - 2)
-        frac = ((y - rows[k]) / (rows[k + 1] - rows[k]))[..., None]
+        k, frac = between_knots(rows, np.nan_to_num(src[..., 1], nan=rows[0]))
         below = np.take(flat, first + k, axis=0)
-        src = finish(below + frac * (np.take(flat, first + k + 1, axis=0) - below))
+        src = finish(below + frac[..., None] * (np.take(flat, first + k + 1, axis=0) - below))
     return np.swapaxes(src, 0, 1)
 
 
