@@ -1,9 +1,17 @@
-"""Repairing the frames whose rotation too few flow vectors agreed on.
+"""Repairing the frames whose rotation too few flow vectors agreed on, and that jump.
 
 A close moving subject can fill the frame and win the vote with a handful of vectors;
-one such frame is a jump in the path that the smoothing then has to zoom around. Its
-rotation is replaced by the mean rotation vector of the reliable frames within
-``REPAIR_WINDOW`` (or the nearest reliable one).
+one such frame is a jump in the path that the smoothing then has to zoom around. A frame
+whose support is low is repaired only if it also jumps: if its rotation vector lies
+further from the mean of the reliable frames within ``REPAIR_WINDOW`` than
+``JUMP_SPREADS`` times their own spread about that mean (and more than ``MIN_JUMP_DEG``);
+it is then replaced by that mean (or by the nearest reliable frame's rotation).
+
+Low support alone is no reason: motion blur and near walls lower it while the estimate
+stays right. On a rendered 30° walk the five frames of least support (0.13–0.15, a
+quarter of the median) were within 0.02–0.09° of the truth; replaced by their
+neighbours' mean they were 0.47–0.95° off, since a walk's shake changes its direction
+within three frames, and the residual shake of the output rose from 6.43 to 7.77 px.
 """
 
 from __future__ import annotations
@@ -16,23 +24,34 @@ from rotation import so3
 MIN_SUPPORT = 0.03  # below this share of agreeing vectors a frame's rotation is a guess
 RELATIVE_SUPPORT = 0.35  # ...or below this fraction of the clip's median support
 REPAIR_WINDOW = 3  # frames on each side whose rotations stand in for an unreliable one
+JUMP_SPREADS = 3.0  # a low-support frame this many neighbour spreads off their mean jumps
+MIN_JUMP_DEG = 0.2  # ...and at least this far (a steady camera's spread is ~0)
 
 
 def repair_unreliable(R: NDArray, support: NDArray) -> tuple[NDArray, NDArray]:
-    """Replace the rotations R (N-1, 3, 3) whose ``support`` is too low.
+    """Replace the rotations R (N-1, 3, 3) whose ``support`` is too low and that jump
+    away from their neighbours'.
 
-    Returns (R, reliable mask); all frames count as reliable when none, or all, are.
+    Returns (R, reliable mask); all frames count as reliable when none, or all, are
+    short of support.
     """
     support = np.asarray(support)
-    reliable = support >= max(MIN_SUPPORT, RELATIVE_SUPPORT * float(np.median(support)))
-    if reliable.all() or not reliable.any():
+    supported = support >= max(MIN_SUPPORT, RELATIVE_SUPPORT * float(np.median(support)))
+    if supported.all() or not supported.any():
         return R, np.ones(len(R), bool)
     rotvecs = so3.log_so3(R)
-    good = np.flatnonzero(reliable)
+    good = np.flatnonzero(supported)
     out = rotvecs.copy()
-    for k in np.flatnonzero(~reliable):
+    reliable = supported.copy()
+    for k in np.flatnonzero(~supported):
         near = good[np.abs(good - k) <= REPAIR_WINDOW]
         if near.size == 0:
             near = good[[np.argmin(np.abs(good - k))]]
-        out[k] = rotvecs[near].mean(axis=0)
+        mean = rotvecs[near].mean(axis=0)
+        spread = np.sqrt(np.mean(np.sum((rotvecs[near] - mean) ** 2, axis=1)))
+        jump = np.linalg.norm(rotvecs[k] - mean)
+        if jump > max(JUMP_SPREADS * spread, np.radians(MIN_JUMP_DEG)):
+            out[k], reliable[k] = mean, False
+        else:
+            reliable[k] = True
     return so3.exp_so3(out), reliable
