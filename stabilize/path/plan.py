@@ -82,7 +82,8 @@ def plan_path(
         need = np.ones(len(O))
     elif over(path, everything).any():
         parts = planar.MOTION_MODELS[settings.motion] if measured else ()
-        solved = optimal_path(path, sources, size, parts, CORNERS, _ceiling(raw, path, parts))
+        ceiling, sigma = _ceiling(raw, path, parts), settings.smooth / _frame_interval(times)
+        solved = optimal_path(path, sources, size, parts, CORNERS, ceiling, sigma)
         if solved is not None:
             path, need = solved, zoom_of(solved, everything)
         else:  # the programme failed: bend, first giving up the slow part of the smoothing
@@ -107,3 +108,8 @@ def _ceiling(raw: Trajectory, path: Trajectory, parts: tuple[int, ...]) -> NDArr
     if 3 in parts:
         ceiling[:, 3 + parts.index(3)] = raw.shift[:, 3] - path.shift[:, 3]
     return ceiling
+
+
+def _frame_interval(times: NDArray) -> float:
+    """The median frame interval, s (1/30 for a single frame)."""
+    return float(np.median(np.diff(times))) if len(times) > 1 else 1 / 30
