@@ -36,7 +36,7 @@ def run(clip: Path, out: Path, settings: Settings, bend: bool) -> tuple[float, i
         summary, planned = stabilize_video(clip, out, settings, overwrite=True)
     info = probe(clip)
     _, metrics = evaluate_pair(read_frames(clip), read_frames(out, info.size), info.fps)
-    framing = Framing(planned.K, info.size)
+    framing = Framing(planned.K, info.size, planned.knot_rows, planned.lens)
     shown = ~framing.covered(planned.corrections(), planned.zoom + 1e-6)
     return metrics.residual_shake_px, int(shown.sum()), summary["seconds"]["plan"]
 

@@ -42,7 +42,7 @@ def repair_unreliable(R: NDArray, support: NDArray) -> tuple[NDArray, NDArray]:
     rotvecs = so3.log_so3(R)
     good = np.flatnonzero(supported)
     out = rotvecs.copy()
-    reliable = supported.copy()
+    reliable = np.ones(len(R), bool)  # a frame is unreliable once it is repaired
     for k in np.flatnonzero(~supported):
         near = good[np.abs(good - k) <= REPAIR_WINDOW]
         if near.size == 0:
@@ -52,6 +52,4 @@ def repair_unreliable(R: NDArray, support: NDArray) -> tuple[NDArray, NDArray]:
         jump = np.linalg.norm(rotvecs[k] - mean)
         if jump > max(JUMP_SPREADS * spread, np.radians(MIN_JUMP_DEG)):
             out[k], reliable[k] = mean, False
-        else:
-            reliable[k] = True
     return so3.exp_so3(out), reliable

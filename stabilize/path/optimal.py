@@ -144,10 +144,11 @@ def _solve_window(
     active = np.zeros(on_target.shape, bool)
     active[fixed:, corners] = True  # the held frames were checked in the last window
     margin = np.full(len(frames), MARGIN_PX)
+    cost = _shake_cost(unrolled(part, parts), sigma)  # the same in every round
     for _ in range(ROUNDS):
         src, jac = _linearised(sources, part, frames, x, parts)
         crop = _crop_rows(src, jac, x, active, margin, lo, hi)
-        solved = _programme(crop, x, fixed, ceiling, unrolled(part, parts), sigma)
+        solved = _programme(crop, x, fixed, ceiling, cost)
         if solved is None:
             return None
         x = solved
@@ -216,25 +217,33 @@ def shake_operator(n: int, k: int, sigma: float) -> sparse.csr_array:
     return sparse.kron(sparse.csr_array(high) @ step, sparse.eye_array(k)).tocsr()
 
 
+def _shake_cost(p0: NDArray, sigma: float) -> tuple[sparse.csc_array, NDArray] | None:
+    """(P, q) of the objective ½ δᵀP δ + qᵀδ = ½ ‖(I - G_σ) Δ(p0 + δ)‖² + ½ η ‖δ‖² + const
+    for the target's unrolled path p0 (n, k); None for fewer than 3 frames."""
+    n, k = p0.shape
+    if n < 3:
+        return None
+    H = shake_operator(n, k, sigma)
+    P = (H.T @ H + HOLD * sparse.eye_array(n * k)).tocsc()
+    return P, H.T @ (H @ p0.ravel())
+
+
 def _programme(
     crop: tuple[sparse.csr_array, NDArray],
     x0: NDArray,
     fixed: int,
     ceiling: NDArray,
-    p0: NDArray,
-    sigma: float,
+    cost: tuple[sparse.csc_array, NDArray] | None,
 ) -> NDArray | None:
-    """Solve the quadratic programme around x0 (the target's unrolled path p0) under the
-    linearised ``crop`` (A, b); None where Clarabel finds no answer."""
+    """Solve the quadratic programme of objective ``cost`` (:func:`_shake_cost`) around
+    x0 under the linearised ``crop`` (A, b); None where Clarabel finds no answer."""
     import clarabel  # loaded with the first programme, not with the planner
 
+    if cost is None:
+        return x0.copy()
+    P, q = cost
     n, k = x0.shape
     nx = n * k
-    if n < 3:
-        return x0.copy()
-    H = shake_operator(n, k, sigma)
-    P = (H.T @ H + HOLD * sparse.eye_array(nx)).tocsc()
-    q = H.T @ (H @ p0.ravel())
     upper = np.maximum(ceiling.ravel(), x0.ravel())
     capped = np.flatnonzero(np.isfinite(upper))
     held = np.arange(fixed * k)
