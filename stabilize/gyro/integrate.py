@@ -26,6 +26,11 @@ from numpy.typing import NDArray
 from rotation import so3
 from stabilize.gyro.log import GyroError, GyroLog
 
+# A camera's own log may start or stop a frame or two off its video: GoPro karma.mp4's
+# GPMF gyro starts 53 ms after the first frame. Up to this much, the end sample's rate
+# is held (a turn of ω·53 ms, against a frame's shake that changes over ~100 ms).
+EDGE_S = 0.1
+
 
 @numba.njit(cache=True)
 def _chain(steps: NDArray) -> NDArray:
@@ -62,8 +67,10 @@ class Attitude:
         return self.at(b) @ np.swapaxes(self.at(a), -1, -2)
 
     def check_covers(self, lo: float, hi: float, offset: float) -> None:
+        """Refuse frames at gyro-clock times lo–hi that the log does not reach, beyond
+        ``EDGE_S`` at either end (there :meth:`at` holds the end sample's rate)."""
         first, last = self.times[0], self.times[-1]
-        if lo < first - 1e-9 or hi > last + 1e-9:
+        if lo < first - EDGE_S or hi > last + EDGE_S:
             raise GyroError(
                 f"{self.source}: the gyro log covers {first - offset:.3f}–{last - offset:.3f} s "
                 f"of video time, the frames {lo - offset:.3f}–{hi - offset:.3f} s"

@@ -82,3 +82,14 @@ def test_lag_shifts_each_interval():
     )
     angle = np.degrees(so3.angle(lagged[1]))  # ∫ t dt over [0.65, 0.75]
     assert angle == pytest.approx(np.degrees(0.5 * (0.75**2 - 0.65**2)), rel=1e-9)
+
+
+def test_a_log_a_frame_short_at_an_end_holds_its_end_rate():
+    # a camera's log that starts 53 ms after the first frame (GoPro karma.mp4)
+    t = np.linspace(0.053, 2.0, 400)
+    w = np.array([0.3, -0.2, 0.5])
+    log = GyroLog(t, np.tile(w, (len(t), 1)), "late")
+    R = integrate_rotations(log, np.array([0.0, 1 / 30, 2 / 30]))
+    np.testing.assert_allclose(R[0], so3.exp_so3(-w / 30), atol=1e-9)
+    with pytest.raises(GyroError, match="covers"):  # half a second short is refused
+        integrate_rotations(GyroLog(t + 0.5, log.rates, "later"), np.array([0.0, 1 / 30]))
