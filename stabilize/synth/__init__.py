@@ -165,8 +165,21 @@ def render_frames(
             yield render_frame(opts, scene, k, with_flow=with_flow)
         return
     _WORKER = (opts, scene, with_flow)
-    with mp.get_context("fork").Pool(workers) as pool:
-        yield from pool.imap(_render_in_worker, frames)
+    # Chunks, with the next one rendering while this one is consumed, and a pool that is
+    # closed and joined rather than terminated: terminating a Pool with tasks in flight
+    # (a caller that takes only the first frame) can deadlock its task-handler thread,
+    # and did, intermittently, in the test suite.
+    pool = mp.get_context("fork").Pool(workers)
+    chunks = [frames[i : i + 2 * workers] for i in range(0, len(frames), 2 * workers)]
+    try:
+        pending = pool.map_async(_render_in_worker, chunks[0])
+        for nxt in [*chunks[1:], None]:
+            done = pending.get()
+            pending = pool.map_async(_render_in_worker, nxt) if nxt is not None else None
+            yield from done
+    finally:
+        pool.close()
+        pool.join()
 
 
 def gyro_samples(opts: SynthOptions) -> tuple[NDArray, NDArray]:
