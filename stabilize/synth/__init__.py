@@ -171,11 +171,12 @@ def render_frames(
     # and did, intermittently, in the test suite.
     pool = mp.get_context("fork").Pool(workers)
     chunks = [frames[i : i + 2 * workers] for i in range(0, len(frames), 2 * workers)]
-    try:
-        pending = pool.map_async(_render_in_worker, chunks[0])
-        for nxt in [*chunks[1:], None]:
-            done = pending.get()
-            pending = pool.map_async(_render_in_worker, nxt) if nxt is not None else None
+    try:  # two chunks in flight, so no worker waits at a chunk's end
+        pending = [pool.map_async(_render_in_worker, c) for c in chunks[:2]]
+        for k in range(len(chunks)):
+            done = pending[k].get()
+            if k + 2 < len(chunks):
+                pending.append(pool.map_async(_render_in_worker, chunks[k + 2]))
             yield from done
     finally:
         pool.close()
