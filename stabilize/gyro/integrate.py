@@ -56,10 +56,15 @@ class Attitude:
         t = np.asarray(t, dtype=np.float64)
         flat = t.ravel()
         i = np.clip(np.searchsorted(self.times, flat, side="right") - 1, 0, len(self.times) - 2)
-        delta = self.times[i + 1] - self.times[i]
+        delta = (self.times[i + 1] - self.times[i])[:, None]
         s = (flat - self.times[i])[:, None]
         w0, w1 = self.rates[i], self.rates[i + 1]
-        phi = w0 * s + (w1 - w0) * s**2 / (2.0 * delta[:, None])
+        # Inside an interval the rate is linear; beyond the log's ends (up to EDGE_S) the
+        # end sample's rate is held. Extrapolating the last interval's slope instead put a
+        # 53 ms edge 1.5° off after one sample 0.05 rad/s out at 369 Hz.
+        inside = np.clip(s, 0.0, delta)
+        phi = w0 * inside + (w1 - w0) * inside**2 / (2.0 * delta)
+        phi += w0 * np.minimum(s, 0.0) + w1 * np.maximum(s - delta, 0.0)
         return (so3.exp_so3(-phi) @ self.G[i]).reshape(*t.shape, 3, 3)
 
     def between(self, a: NDArray, b: NDArray) -> NDArray[np.float64]:

@@ -91,5 +91,9 @@ def test_a_log_a_frame_short_at_an_end_holds_its_end_rate():
     log = GyroLog(t, np.tile(w, (len(t), 1)), "late")
     R = integrate_rotations(log, np.array([0.0, 1 / 30, 2 / 30]))
     np.testing.assert_allclose(R[0], so3.exp_so3(-w / 30), atol=1e-9)
+    bumped = log.rates.copy()  # one sample off: held, the edge turns by the first rate
+    bumped[1] += [0.05, 0.0, 0.0]
+    R = integrate_rotations(GyroLog(t, bumped, "bumped"), np.array([0.0, 0.053]))
+    np.testing.assert_allclose(R[0], so3.exp_so3(-w * 0.053), atol=1e-9)
     with pytest.raises(GyroError, match="covers"):  # half a second short is refused
         integrate_rotations(GyroLog(t + 0.5, log.rates, "later"), np.array([0.0, 1 / 30]))
