@@ -20,8 +20,10 @@ import csv
 import json
 import multiprocessing as mp
 import os
+from collections import deque
 from collections.abc import Callable, Iterator
 from dataclasses import asdict, dataclass, field
+from itertools import islice
 from pathlib import Path
 
 import numpy as np
@@ -165,18 +167,17 @@ def render_frames(
             yield render_frame(opts, scene, k, with_flow=with_flow)
         return
     _WORKER = (opts, scene, with_flow)
-    # Chunks, with the next one rendering while this one is consumed, and a pool that is
+    # Chunks, two in flight so that no worker waits at a chunk's end, and a pool that is
     # closed and joined rather than terminated: terminating a Pool with tasks in flight
     # (a caller that takes only the first frame) can deadlock its task-handler thread,
-    # and did, intermittently, in the test suite.
+    # and did, intermittently, in the test suite. Only the chunks in flight are held.
     pool = mp.get_context("fork").Pool(workers)
-    chunks = [frames[i : i + 2 * workers] for i in range(0, len(frames), 2 * workers)]
-    try:  # two chunks in flight, so no worker waits at a chunk's end
-        pending = [pool.map_async(_render_in_worker, c) for c in chunks[:2]]
-        for k in range(len(chunks)):
-            done = pending[k].get()
-            if k + 2 < len(chunks):
-                pending.append(pool.map_async(_render_in_worker, chunks[k + 2]))
+    chunks = iter([frames[i : i + 2 * workers] for i in range(0, len(frames), 2 * workers)])
+    try:
+        pending = deque(pool.map_async(_render_in_worker, c) for c in islice(chunks, 2))
+        while pending:
+            done = pending.popleft().get()
+            pending.extend(pool.map_async(_render_in_worker, c) for c in islice(chunks, 1))
             yield from done
     finally:
         pool.close()
