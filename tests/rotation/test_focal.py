@@ -46,3 +46,21 @@ def test_no_motion_pins_nothing_down():
         est.grid.x, est.grid.y, zeros, zeros, zeros == 0, np.zeros((40, 3)), start, BOUNDS
     )
     assert found.focal is None and math.isclose(found.depth, 0.0, abs_tol=1e-9)
+
+
+def test_a_curve_flat_on_one_side_pins_nothing_down(monkeypatch):
+    """cockatoo (a bird filling the frame): the cost lay flat to 0.001% over the long
+    focal lengths, and its minimum there, a hair below the rest, read 18.5°."""
+    from rotation import focal as module
+
+    floor = np.r_[np.linspace(2.0, 1.0, 15), np.ones(10)]
+    floor[20] -= 1e-6  # the minimum, inside the flat part
+    dip = floor + 0.05 * np.abs(np.arange(25) - 20) * (np.arange(25) >= 15)  # a valley
+    start = focal_from_fov(69.0, SIZE[1])
+    est = HoughEstimator(SIZE, start)
+    zeros = np.zeros((40, len(est.grid.x)))
+    args = (est.grid.x, est.grid.y, zeros, zeros, zeros == 0, np.zeros((40, 3)), start, BOUNDS)
+    for curve, pinned in ((floor, False), (dip, True)):
+        costs = iter([curve, np.linspace(1.1, 1.1, 9) - 0.1 * np.hanning(9)])
+        monkeypatch.setattr(module, "_costs", lambda _args, focals, c=costs: next(c))
+        assert (estimate_focal(*args).focal is not None) is pinned
