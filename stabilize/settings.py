@@ -35,7 +35,7 @@ class Settings:
     method: str = "adaptive"  # smoothing method (stabilize.path.smoothing.METHODS)
     # what the warp compensates: the rotation alone, or also the image motion it leaves
     # (stabilize.path.residual.MOTION_MODELS)
-    motion: str = "translation"
+    motion: str = "similarity"
     max_zoom: float = DEFAULT_MAX_ZOOM
     crop: str = "auto"  # zoom mode (stabilize.path.zoom.CROP_MODES)
     max_deg: float = 15.0  # the estimator's search range per frame pair

@@ -66,3 +66,22 @@ def test_a_residual_reexpressed_after_another_rotation_matches_one_measured_afte
     measured = residual_motion(x, y, u[None], v[None], valid, R_true[None], F)
     moved = reexpress(measured, R_true[None], R_other[None], F, (360, 640))
     assert np.abs((moved - direct)[:, :2]).max() * F < 0.05
+
+
+def test_a_rotation_that_explains_little_of_the_frame_gives_no_zoom_or_roll():
+    """cockatoo: a bird's face, close to the lens, won some pairs' vote, and its
+    approach read as the camera's zoom. Where the rotation explains under 40% of the
+    frame's vectors, only the translation counts: the camera's zoom here is none."""
+    x, y = _grid()
+    R_bird = so3.exp_so3(np.array([0.0, 0.01, 0.0]))
+    bird = np.hypot(x / 300, y / 170) < 0.6
+    assert 0.2 < bird.mean() < 0.4
+    u, v = _flow(x, y, np.eye(3), (0.0, 0.0))  # the room: still, 4 px off the bird's turn
+    u_bird, v_bird = _flow(x, y, R_bird, (0.0, 0.0), scale=0.01)  # it comes 1% closer
+    u[bird], v[bird] = u_bird[bird], v_bird[bird]
+    valid = np.ones((1, len(x)), bool)
+    residual = residual_motion(x, y, u[None], v[None], valid, R_bird[None], F)[0]
+    assert residual[2] == 0.0 and residual[3] == 0.0
+    # Fitted on the bird alone, the zoom is the bird's:
+    alone = residual_motion(x, y, u[None], v[None], bird[None], R_bird[None], F)[0]
+    assert alone[2] == pytest.approx(0.01, abs=1e-3)
