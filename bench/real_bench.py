@@ -4,7 +4,8 @@ on rendered walks at fields of view the tool is not told.
 Each clip is stabilised by both tools with the same encoder (libx264, CRF 18, preset
 medium; see ``stabilize_bench.py``), and the table gives, for the original and for each
 output, the residual shake (``stabilize evaluate``: the RMS of the high-passed
-frame-to-frame similarity motion, px at the clip's width), the wobble (a rolling
+frame-to-frame similarity motion, px at the clip's width) and its parts (x, y, roll,
+zoom: on a walk past near surfaces the zoom is the metric's noisiest), the wobble (a rolling
 shutter's shear and stretch between frames, px), stability, cropping,
 distortion and wall time, then the median of ours ÷ vid.stab's residual shake.
 
@@ -61,7 +62,7 @@ def main() -> None:
     ratios = []
     header = (
         f"{'clip':28s}{'tool':10s}{'shake px':>9s}{'wobble':>7s}{'stab':>7s}{'crop':>7s}"
-        f"{'dist':>7s}{'s':>7s}"
+        f"{'dist':>7s}{'s':>7s}   x / y / roll / zoom px"
     )
     print(header)
     for clip in args.clips or clips(work):
@@ -86,9 +87,10 @@ def main() -> None:
 
 def _row(clip: str, tool: str, m, seconds: float | None) -> str:
     t = f"{seconds:7.1f}" if seconds is not None else f"{'':7s}"
+    parts = " / ".join(f"{x:.2f}" for x in m.shake_components_px)
     return (
         f"{clip:28s}{tool:10s}{m.residual_shake_px:9.3f}{m.wobble_px:7.3f}{m.stability:7.3f}"
-        f"{m.cropping_ratio:7.3f}{m.distortion:7.3f}{t}"
+        f"{m.cropping_ratio:7.3f}{m.distortion:7.3f}{t}   {parts}"
     )
 
 

@@ -21,7 +21,8 @@ from stabilize.cli.app import app, fail
         "each frame-to-frame motion (dx, dy, and the rotation and zoom as the px they move "
         "the frame's side, at the clip's width) is high-passed (minus a Gaussian low-pass, "
         "sigma 0.5 s, which keeps pans and walks); the shake is the RMS length of what is "
-        "left, in px, and of its rotation alone, in degrees. Lower is steadier.\n\n"
+        "left, in px, and of its rotation alone, in degrees; its parts, the RMS of each "
+        "component (x, y, roll, zoom), say what is left. Lower is steadier.\n\n"
         "Wobble (a rolling shutter's jello): of each frame-to-frame homography (ORB, "
         "RANSAC), its linear part at the frame's centre [[a, b], [c, d]]; the part no "
         "similarity has, ((a - d)/2, (b + c)/2), the stretch and the shear, times half the "
@@ -77,16 +78,22 @@ def evaluate(
         ("ITF (dB)", "itf_db", "{:.2f}"),
         ("residual shake (px)", "residual_shake_px", "{:.3f}"),
         ("residual shake (deg)", "residual_shake_deg", "{:.4f}"),
+        ("  x, y, roll, zoom (px)", "shake_components_px", "{:.2f}/{:.2f}/{:.2f}/{:.2f}"),
         ("wobble (px)", "wobble_px", "{:.3f}"),
         ("frames", "frames", "{}"),
     ]
     typer.echo(f"{'metric':26s}{'original':>12s}{'stabilised':>12s}")
     for label, key, fmt in rows:
-        a, b = fmt.format(result["original"][key]), fmt.format(result["stabilised"][key])
-        typer.echo(f"{label:26s}{a:>12s}{b:>12s}")
+        a, b = (_formatted(fmt, result[clip][key]) for clip in ("original", "stabilised"))
+        typer.echo(f"{label:26s}{a:>12s}{b:>{max(12, len(b) + 1)}s}")
     if "rotations" in result:
         r = result["rotations"]
         typer.echo(
             f"rotation error vs truth: AAE {r['aae_deg']:.4f}°, median "
             f"{r['median_deg']:.4f}°, p95 {r['p95_deg']:.4f}° over {r['pairs']} pairs"
         )
+
+
+def _formatted(fmt: str, value) -> str:
+    """A value, or a list of them (the shake's parts), by a format."""
+    return fmt.format(*value) if isinstance(value, list | tuple) else fmt.format(value)

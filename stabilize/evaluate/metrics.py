@@ -30,7 +30,12 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.evaluate.shake import matched_points, residual_shake, similarity_motion
+from stabilize.evaluate.shake import (
+    matched_points,
+    residual_shake,
+    shake_components,
+    similarity_motion,
+)
 from stabilize.evaluate.wobble import non_similar_part, wobble
 
 MIN_MATCHES = 12
@@ -175,6 +180,8 @@ class ClipMetrics:
     registration_failures: int
     residual_shake_px: float  # stabilize.evaluate.shake: RMS of the high-passed 2-D motion
     residual_shake_deg: float
+    # the shake's parts (dx, dy, roll, zoom), px: what is left, and where the metric is noisy
+    shake_components_px: tuple[float, float, float, float]
     wobble_px: float  # stabilize.evaluate.wobble: RMS shear and stretch between frames
 
     def as_dict(self) -> dict:
@@ -215,9 +222,10 @@ class _Clip:
     def metrics(self, scales: list[float], ratios: list[float], fps: float) -> ClipMetrics:
         st, sr = stability(self.inter)
         h, w = self.shape[:2] if self.shape else (0, 0)
-        shake = residual_shake(
+        parts = shake_components(
             np.array(self.motions).reshape(-1, 4), w, fps, ((w - 1) / 2, (h - 1) / 2)
         )
+        shake = residual_shake(parts, w)
         return ClipMetrics(
             frames=self.frames,
             cropping_ratio=float(np.mean(scales)) if scales else 1.0,
@@ -229,6 +237,7 @@ class _Clip:
             registration_failures=self.reg.failures,
             residual_shake_px=shake[0],
             residual_shake_deg=shake[1],
+            shake_components_px=tuple(float(x) for x in parts),
             wobble_px=wobble(np.array(self.skews), w),
         )
 

@@ -1,5 +1,8 @@
 """``stabilize evaluate``: the metrics of two clips, as text and JSON."""
 
+import json
+
+import pytest
 from typer.testing import CliRunner
 
 from stabilize.cli import app
@@ -14,5 +17,12 @@ def test_evaluate_command(tmp_path):
                                       f"{sample}/truth.csv", "--json"])  # fmt: skip
     assert result.exit_code == 0, result.output
     assert '"aae_deg": 0.0' in result.output
+    metrics = json.loads(result.output)["stabilised"]
+    parts = metrics["shake_components_px"]  # x, y, roll, zoom: their length is the shake
+    assert len(parts) == 4 and sum(x * x for x in parts) ** 0.5 == pytest.approx(
+        metrics["residual_shake_px"]
+    )
+    text = CliRunner().invoke(app, ["evaluate", f"{sample}/clip.mp4", f"{sample}/clip.mp4"])
+    assert text.exit_code == 0 and "x, y, roll, zoom (px)" in text.output
     bad = CliRunner().invoke(app, ["evaluate", "README.md", f"{sample}/clip.mp4"])
     assert bad.exit_code != 0 and "not a video" in bad.output
