@@ -56,11 +56,15 @@ def test_a_curve_flat_on_one_side_pins_nothing_down(monkeypatch):
     floor = np.r_[np.linspace(2.0, 1.0, 15), np.ones(10)]
     floor[20] -= 1e-6  # the minimum, inside the flat part
     dip = floor + 0.05 * np.abs(np.arange(25) - 20) * (np.arange(25) >= 15)  # a valley
+    # a narrow lens's: the long side rises slowly (a 31° crop of phone-cc9's real frames
+    # rose 0.01% and 0.09% one and two candidates out, 0.25% at the end)
+    narrow = dip.copy()
+    narrow[21:] = 1.0 + 4e-4 * np.arange(1, 5)  # 0.08% two out: a floor by that alone
     start = focal_from_fov(69.0, SIZE[1])
     est = HoughEstimator(SIZE, start)
     zeros = np.zeros((40, len(est.grid.x)))
     args = (est.grid.x, est.grid.y, zeros, zeros, zeros == 0, np.zeros((40, 3)), start, BOUNDS)
-    for curve, pinned in ((floor, False), (dip, True)):
+    for curve, pinned in ((floor, False), (dip, True), (narrow, True)):
         costs = iter([curve, np.linspace(1.1, 1.1, 9) - 0.1 * np.hanning(9)])
         monkeypatch.setattr(module, "_costs", lambda _args, focals, c=costs: next(c))
         assert (estimate_focal(*args).focal is not None) is pinned
