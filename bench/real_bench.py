@@ -1,5 +1,5 @@
-"""Real footage: ours against FFmpeg's vid.stab on every real clip in ../shared/data, and
-on rendered walks at fields of view the tool is not told.
+"""Real footage: ours against FFmpeg's vid.stab on every real clip in ../shared/data (and
+phone-cc9 zoomed in to 31°), and on rendered walks at fields of view the tool is not told.
 
 Each clip is stabilised by both tools with the same encoder (libx264, CRF 18, preset
 medium; see ``stabilize_bench.py``), and the table gives, for the original and for each
@@ -32,18 +32,25 @@ from stabilize.video import ffmpeg_exe, probe, read_frames
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
 REAL = ("handheld/cockatoo.mp4", "gopro/karma.mp4", "gopro/hero7.mp4", "gopro/max-heromode.mp4")
 RENDERED_FOV = (30.0, 45.0, 100.0)  # walks past near walls, at these unknown fields of view
+# phone-cc9 zoomed in, as a phone's digital zoom does: its frames' middle 320×240 about the
+# principal point (406.01, 309.01), shown at 640×480: a real 31° clip whose f is known
+# (2 × 573.85 px), the kind of narrow clip (a zoo, a stage) where a wrong f shows most
+ZOOM_CROP = "crop=320:240:246:189,scale=640:480"
 
 
 def clips(work: Path) -> list[Path]:
-    """The real clips, phone-cc9's frames as a clip, and the rendered walks."""
+    """The real clips, phone-cc9's frames as a clip and zoomed in, and the rendered
+    walks."""
     found = [SHARED / name for name in REAL if (SHARED / name).is_file()]
     frames = SHARED / "phone-cc9" / "frames"
     if frames.is_dir():
         cc9 = work / "phone-cc9.mp4"
         pattern = ["-framerate", "30", "-start_number", "99", "-i", str(frames / "RE_frame-%d.jpg")]
         cmd = [ffmpeg_exe(), "-v", "error", "-y", *pattern, "-c:v", "libx264", "-crf", "12"]
-        subprocess.run([*cmd, "-pix_fmt", "yuv420p", str(cc9)], check=True)
-        found.append(cc9)
+        zoomed = work / "phone-cc9-zoom31.mp4"
+        for out, view in ((cc9, []), (zoomed, ["-vf", ZOOM_CROP])):
+            subprocess.run([*cmd, *view, "-pix_fmt", "yuv420p", str(out)], check=True)
+            found.append(out)
     from stabilize.synth import SynthOptions, render_clip
 
     for fov in RENDERED_FOV:
