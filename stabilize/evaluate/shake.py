@@ -12,8 +12,9 @@ residual shake is the RMS length of what is left,
 
     shake_px = √ mean_t |v_t - (G_σ * v)_t|²,
 
-and ``shake_deg`` the same for the in-plane rotation alone, in degrees. Lower is steadier;
-a tripod shot scores about 0.
+and ``shake_deg`` the same for the in-plane rotation alone, in degrees; the RMS of each
+component alone (:func:`shake_components`) are its parts. Lower is steadier; a tripod
+shot scores about 0.
 """
 
 from __future__ import annotations
