@@ -75,7 +75,8 @@ def main() -> None:
     for clip in args.clips or clips(work):
         info = probe(clip)
         name = f"{clip.parent.name}/{clip.name}"[-27:]
-        mine, theirs = work / f"{clip.stem}_ours.mp4", work / f"{clip.stem}_vidstab.mp4"
+        tag = f"{clip.parent.name}_{clip.stem}"  # the rendered walks are all clip.mp4
+        mine, theirs = work / f"{tag}_ours.mp4", work / f"{tag}_vidstab.mp4"
         cmd = [sys.executable, "-m", "stabilize.cli", "run", str(clip), str(mine), "-q"]
         t_ours, _ = timed([*cmd, "--overwrite", *(["--fov", args.fov] if args.fov else [])])
         t_vs, _ = vidstab(clip, theirs, work)

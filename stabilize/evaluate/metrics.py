@@ -31,14 +31,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stabilize.evaluate.shake import (
+    MIN_MATCHES,
     matched_points,
     residual_shake,
     shake_components,
     similarity_motion,
+    spread_out,
 )
 from stabilize.evaluate.wobble import non_similar_part, wobble
 
-MIN_MATCHES = 12
 FEATURES = 2000  # ORB features per frame for registration
 GRID = (6, 8)  # cells they are spread over
 LOW_BAND = slice(1, 6)  # the 2nd to the 6th FFT components (index 0 is DC)
@@ -69,24 +70,17 @@ class Registrar:
         pts = np.float32([k.pt for k in kp]) * scale if kp else np.zeros((0, 2), np.float32)
         return pts, desc
 
-    def homography(self, a, b) -> NDArray[np.float64]:
-        """H with b ~ H a, from features() of two frames; identity if it cannot be found."""
-        (pa, da), (pb, db) = a, b
-        if da is None or db is None or len(pa) < MIN_MATCHES or len(pb) < MIN_MATCHES:
-            self.failures += 1
-            return np.eye(3)
-        pairs = self.matcher.knnMatch(da, db, k=2)
-        good = [m[0] for m in pairs if len(m) == 2 and m[0].distance < 0.8 * m[1].distance]
-        if len(good) < MIN_MATCHES:
-            self.failures += 1
-            return np.eye(3)
-        src = pa[[m.queryIdx for m in good]]
-        dst = pb[[m.trainIdx for m in good]]
-        H, mask = cv2.findHomography(src, dst, cv2.USAC_MAGSAC, 1.5)
-        if H is None or mask.sum() < MIN_MATCHES:
-            self.failures += 1
-            return np.eye(3)
-        return H / H[2, 2]
+    def homography(self, a, b, width: int) -> NDArray[np.float64]:
+        """H with b ~ H a, from features() of two frames ``width`` px wide; identity if it
+        cannot be found, or if its inliers bunch together (:func:`spread_out`)."""
+        matched = matched_points(a, b, self.matcher)
+        if matched is not None:
+            H, mask = cv2.findHomography(*matched, cv2.USAC_MAGSAC, 1.5)
+            if H is not None and mask.sum() >= MIN_MATCHES:
+                if spread_out(matched[0][mask.ravel() > 0], width):
+                    return H / H[2, 2]
+        self.failures += 1
+        return np.eye(3)
 
 
 def spread(keypoints, shape: tuple[int, int], grid: tuple[int, int] = GRID) -> list:
@@ -206,9 +200,10 @@ class _Clip:
         feat = self.reg.features(frame)
         grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         if self.previous is not None:
-            self.inter.append(self.reg.homography(self.previous[0], feat))
+            width = frame.shape[1]
+            self.inter.append(self.reg.homography(self.previous[0], feat, width))
             matched = matched_points(self.previous[0], feat, self.reg.matcher)
-            motion = None if matched is None else similarity_motion(*matched)
+            motion = None if matched is None else similarity_motion(*matched, width)
             self.motions.append(np.zeros(4) if motion is None else motion)
             if not np.array_equal(self.inter[-1], np.eye(3)):  # registered
                 centre = ((frame.shape[1] - 1) / 2, (frame.shape[0] - 1) / 2)
@@ -257,7 +252,7 @@ def evaluate_pair(
     for orig, stab in zip(original, stabilised, strict=False):
         feat_orig, feat_stab = before.add(orig), after.add(stab)
         # Stabilised → original: a zoomed-in output registers with scale < 1.
-        H = after.reg.homography(feat_stab, feat_orig)
+        H = after.reg.homography(feat_stab, feat_orig, stab.shape[1])
         center = ((stab.shape[1] - 1) / 2, (stab.shape[0] - 1) / 2)
         scale, ratio = scale_and_distortion(H, center)
         scales.append(scale)
