@@ -68,6 +68,8 @@ def similarity_motion(src: NDArray, dst: NDArray, width: int) -> NDArray[np.floa
     if M is None or inliers.sum() < MIN_MATCHES or not spread_out(src[inliers.ravel() > 0], width):
         return None
     scale = float(np.hypot(M[0, 0], M[1, 0]))
+    if not scale > 0:  # a degenerate fit: every point sent to one place
+        return None
     return np.array([M[0, 2], M[1, 2], np.arctan2(M[1, 0], M[0, 0]), np.log(scale)])
 
 
