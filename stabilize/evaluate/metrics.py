@@ -32,11 +32,12 @@ from numpy.typing import NDArray
 
 from stabilize.evaluate.shake import (
     MIN_MATCHES,
+    MIN_SPREAD,
     matched_points,
+    principal_spread,
     residual_shake,
     shake_components,
     similarity_motion,
-    spread_out,
 )
 from stabilize.evaluate.wobble import non_similar_part, wobble
 
@@ -72,12 +73,13 @@ class Registrar:
 
     def homography(self, a, b, width: int) -> NDArray[np.float64]:
         """H with b ~ H a, from features() of two frames ``width`` px wide; identity if it
-        cannot be found, or if its inliers bunch together (:func:`spread_out`)."""
+        cannot be found, or if its inliers spread less than ``MIN_SPREAD`` of the width
+        across their narrowest direction (a strip, which leaves the rest undetermined)."""
         matched = matched_points(a, b, self.matcher)
         if matched is not None:
             H, mask = cv2.findHomography(*matched, cv2.USAC_MAGSAC, 1.5)
             if H is not None and mask.sum() >= MIN_MATCHES:
-                if spread_out(matched[0][mask.ravel() > 0], width):
+                if principal_spread(matched[0][mask.ravel() > 0])[0] >= MIN_SPREAD * width:
                     return H / H[2, 2]
         self.failures += 1
         return np.eye(3)

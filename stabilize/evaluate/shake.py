@@ -26,11 +26,13 @@ from scipy.ndimage import gaussian_filter1d
 
 CUTOFF_S = 0.5  # σ of the low-pass that separates intended motion from shake
 MIN_MATCHES = 12
-# The spread of a fit's inliers across their narrowest direction (standard deviation), as a
-# share of the frame's width, below which the fit is not determined: on the feathers of a
-# crop of cockatoo.mp4, 13 inliers within 22×6 px of a 640 px frame fitted a similarity of
-# scale 1e-17 (the clip read 724 px of shake), and 25 in a strip 46 px across a homography
-# whose "distortion" read 0.11; evenly spread features spread about 0.16 of the width
+# How far a fit's inliers must spread, as a share of the frame's width, for the fit to be
+# determined: a similarity needs it overall (RMS distance from their centroid), a
+# homography across their narrowest direction too. On the feathers of a crop of
+# cockatoo.mp4, 13 inliers within 22×6 px of a 640 px frame fitted a similarity of scale
+# 1e-17 (the clip read 724 px of shake), and 25 in a strip 46 px across a homography whose
+# "distortion" read 0.11; features spread evenly over a 16:9 frame spread 0.16 of the
+# width across its height
 MIN_SPREAD = 0.03
 
 
@@ -49,26 +51,25 @@ def matched_points(
     return pa[[m.queryIdx for m in good]], pb[[m.trainIdx for m in good]]
 
 
-def spread_out(points: NDArray, width: int) -> bool:
-    """Whether points (M, 2) lie far enough apart to fix a fit in a frame ``width`` px
-    wide: their standard deviation across their narrowest direction (the smaller
-    principal axis) is at least ``MIN_SPREAD`` of it."""
+def principal_spread(points: NDArray) -> NDArray[np.float64]:
+    """The standard deviations of points (M, 2) along their principal axes, the smaller
+    first (zeros for fewer than 3 points)."""
     p = np.asarray(points, np.float64)
     if len(p) < 3:
-        return False
-    narrowest = np.linalg.eigvalsh(np.cov(p.T))[0]
-    return bool(np.sqrt(max(narrowest, 0.0)) >= MIN_SPREAD * width)
+        return np.zeros(2)
+    return np.sqrt(np.maximum(np.linalg.eigvalsh(np.cov(p.T)), 0.0))
 
 
 def similarity_motion(src: NDArray, dst: NDArray, width: int) -> NDArray[np.float64] | None:
     """(dx, dy, dθ, d ln s) of the similarity taking matched points ``src`` to ``dst``
     (RANSAC) in a frame ``width`` px wide, or None where too few agree or they bunch
-    together (:func:`spread_out`)."""
+    together (their RMS distance from their centroid under ``MIN_SPREAD`` of the width)."""
     M, inliers = cv2.estimateAffinePartial2D(src, dst, method=cv2.RANSAC, ransacReprojThreshold=1.5)
-    if M is None or inliers.sum() < MIN_MATCHES or not spread_out(src[inliers.ravel() > 0], width):
+    if M is None or inliers.sum() < MIN_MATCHES:
         return None
+    overall = float(np.linalg.norm(principal_spread(src[inliers.ravel() > 0])))
     scale = float(np.hypot(M[0, 0], M[1, 0]))
-    if not scale > 0:  # a degenerate fit: every point sent to one place
+    if overall < MIN_SPREAD * width or not scale > 0:  # (scale 0: all sent to one place)
         return None
     return np.array([M[0, 2], M[1, 2], np.arctan2(M[1, 0], M[0, 0]), np.log(scale)])
 

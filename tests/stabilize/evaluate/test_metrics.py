@@ -74,8 +74,8 @@ def test_registration_survives_featureless_frames():
 
 
 def test_a_thin_strip_of_texture_registers_as_failures_not_as_distortion():
-    # Only a band 8 px high carries features: no homography or similarity is pinned down
-    # across it, and a fit through it would read as any stretch (cockatoo's feathers: 0.11)
+    # Only a band 8 px high carries features: no homography is pinned down across it, and
+    # a fit through it would read as any stretch (cockatoo's feathers: 0.11)
     rng = np.random.default_rng(4)
     frames = []
     for k in range(8):
@@ -83,8 +83,8 @@ def test_a_thin_strip_of_texture_registers_as_failures_not_as_distortion():
         frame[86:94] = rng.integers(0, 256, (8, 320, 1), dtype=np.uint8)
         frames.append(np.roll(frame, k, axis=1))
     _, m = evaluate_pair(frames, frames)
-    assert m.distortion == 1.0 and m.residual_shake_px == 0.0
-    assert m.registration_failures >= len(frames)
+    assert m.distortion == 1.0 and m.registration_failures >= len(frames)
+    assert m.residual_shake_px == pytest.approx(0.0, abs=0.05)  # a steady 1 px pan
 
 
 def test_the_wobble_is_the_shear_between_frames_in_pixels(shaken):

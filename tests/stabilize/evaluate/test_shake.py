@@ -4,11 +4,10 @@ import numpy as np
 import pytest
 
 from stabilize.evaluate.shake import (
-    MIN_SPREAD,
+    principal_spread,
     residual_shake,
     shake_components,
     similarity_motion,
-    spread_out,
 )
 
 WIDTH, FPS = 400, 30.0
@@ -61,14 +60,22 @@ def test_a_similarity_of_spread_points_is_recovered():
     assert motion == pytest.approx([3.0, -2.0, 0.01, np.log(1.02)], abs=1e-3)
 
 
-def test_points_bunched_in_a_strip_fix_no_similarity():
-    # 13 matches within 22 × 6 px (cockatoo's feathers) fitted a scale of 1e-17: the
-    # strip pins neither the roll nor the scale down
-    strip = np.random.default_rng(2).uniform([100, 100], [300, 106], (40, 2)).astype(np.float32)
-    assert not spread_out(strip, WIDTH)
-    assert (
-        similarity_motion(strip, similar(strip, 1.0, 0.0, 0.0, 1.0).astype(np.float32), WIDTH)
-        is None
+def test_points_bunched_together_fix_no_similarity():
+    # 13 matches within 22 × 6 px (cockatoo's feathers) fitted a scale of 1e-17: a
+    # cluster pins neither the roll nor the scale down
+    rng = np.random.default_rng(2)
+    cluster = rng.uniform([100, 100], [122, 106], (40, 2)).astype(np.float32)
+    moved = similar(cluster, 1.0, 0.0, 0.0, 1.0).astype(np.float32)
+    assert similarity_motion(cluster, moved, WIDTH) is None
+
+
+def test_a_long_strip_of_points_fixes_a_similarity():
+    # along a strip the roll and the scale show; only a homography needs more
+    strip = np.random.default_rng(3).uniform([0, 100], [WIDTH, 106], (60, 2)).astype(np.float32)
+    moved = similar(strip, -1.0, 2.0, 0.005, 0.99).astype(np.float32)
+    assert similarity_motion(strip, moved, WIDTH) == pytest.approx(
+        [-1.0, 2.0, 0.005, np.log(0.99)], abs=2e-3
     )
-    wide = np.array([[0, 0], [0, 1], [1, 0], [1, 1]]) * 4 * MIN_SPREAD * WIDTH
-    assert spread_out(wide, WIDTH)
+    narrow, wide = principal_spread(strip)
+    assert narrow == pytest.approx(6 / np.sqrt(12), rel=0.3)
+    assert wide == pytest.approx(WIDTH / np.sqrt(12), rel=0.2)
