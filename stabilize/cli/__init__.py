@@ -9,19 +9,21 @@ so ``--help`` stays fast.
 
 from __future__ import annotations
 
+import os
 import sys
 
 import typer
 from typer.exceptions import TyperException
 
 from stabilize.cli import batch, compare, evaluate, rotations, run, synth
-from stabilize.cli.app import BAD_INPUT, app
+from stabilize.cli.app import BAD_INPUT, FAILED, app, one_line
 
 COMMANDS = ("run", "rotations", "synth", "evaluate", "compare", "batch")
 __all__ = ["COMMANDS", "app", "batch", "compare", "evaluate", "main", "rotations", "run", "synth"]
 
 
 TOP_LEVEL = ("--help", "-h", "--version")  # what the app itself answers
+DEBUG = "STABILIZE_DEBUG"  # set: an internal error ends with its traceback
 
 
 def main() -> None:
@@ -29,7 +31,8 @@ def main() -> None:
 
     A line that names no command runs the main job, wherever its options stand
     (``stabilize -q in.mp4 out.mp4``). A usage mistake is one ``error:`` line and exit
-    status 2, as every other failure; Ctrl-C ends with one line and status 130.
+    status 2, as every other failure; Ctrl-C ends with one line and status 130; a fault
+    of ours (an exception no command turned into an ``error:`` line) one line and status 1.
     """
     args = sys.argv[1:]
     if args and args[0] not in COMMANDS and args[0] not in TOP_LEVEL:
@@ -44,6 +47,16 @@ def main() -> None:
     except KeyboardInterrupt:
         typer.echo("error: interrupted; nothing was written under the output's name", err=True)
         status = 130
+    except Exception as err:  # a fault of ours, not of the input: one line, not a traceback
+        if os.environ.get(DEBUG):
+            raise
+        typer.echo(
+            f"error: internal error ({type(err).__name__}: {one_line(str(err))}); nothing was "
+            f"written under the output's name; set {DEBUG}=1 for the traceback, and please "
+            "report it",
+            err=True,
+        )
+        status = FAILED
     sys.exit(status or 0)
 
 

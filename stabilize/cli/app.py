@@ -71,10 +71,20 @@ BAD_INPUT = 2  # exit status: a bad input or option (nothing was done)
 FAILED = 1  # exit status: a failure while working
 
 
+LONGEST = 400  # characters of a message shown on its error line
+
+
+def one_line(message: str) -> str:
+    """A message as one line: its whitespace and line breaks collapsed, cut at
+    ``LONGEST`` characters (a library's message may carry a whole array)."""
+    line = " ".join(str(message).split())
+    return line if len(line) <= LONGEST else line[: LONGEST - 1] + "…"
+
+
 def fail(message: str, status: int = BAD_INPUT) -> NoReturn:
     """One clear line on stderr and a non-zero exit: 2 for a bad input or option, 1 for a
     failure while working."""
-    typer.echo(f"error: {message}", err=True)
+    typer.echo(f"error: {one_line(message)}", err=True)
     raise typer.Exit(status)
 
 
