@@ -9,6 +9,8 @@ import numpy as np
 import typer
 
 from stabilize.cli.app import app, fail
+from stabilize.cli.bars import progress_bar
+from stabilize.cli.options import QuietOption
 
 
 @app.command(
@@ -38,6 +40,7 @@ def evaluate(
         None, help="An estimated rotations file (frame,t,rx,ry,rz,...) to score against --truth."
     ),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON on stdout."),
+    quiet: QuietOption = False,
 ) -> None:
     """Cropping ratio, distortion, stability, ITF, residual shake and wobble of a
     stabilised clip and its original."""
@@ -50,11 +53,13 @@ def evaluate(
     try:
         info_o, info_s = probe(original), probe(stabilised)
         size = info_o.size
-        before, after = evaluate_pair(
-            read_frames(original, info=info_o),
-            read_frames(stabilised, size, info_s),
-            info_o.fps or 30.0,
-        )
+        with progress_bar("evaluating", None, quiet=quiet) as advance:
+            before, after = evaluate_pair(
+                read_frames(original, info=info_o),
+                read_frames(stabilised, size, info_s),
+                info_o.fps or 30.0,
+                advance,
+            )
         result = {"original": before.as_dict(), "stabilised": after.as_dict()}
         if truth is not None:
             err = angular_errors(read_rotations(rotations), read_rotations(truth))

@@ -40,6 +40,7 @@ from stabilize.evaluate.shake import (
     similarity_motion,
 )
 from stabilize.evaluate.wobble import non_similar_part, wobble
+from stabilize.progress import Progress, no_progress
 
 FEATURES = 2000  # ORB features per frame for registration
 GRID = (6, 8)  # cells they are spread over
@@ -243,8 +244,10 @@ def evaluate_pair(
     original: Iterable[NDArray[np.uint8]],
     stabilised: Iterable[NDArray[np.uint8]],
     fps: float = 30.0,
+    progress: Progress = no_progress,
 ) -> tuple[ClipMetrics, ClipMetrics]:
-    """Metrics of the original and of the stabilised clip, in one pass over both.
+    """Metrics of the original and of the stabilised clip, in one pass over both;
+    ``progress(1)`` after each pair of frames.
 
     Frames are taken in step; if one clip is longer, its extra frames are ignored.
     For the original, cropping ratio and distortion are 1 by definition.
@@ -259,6 +262,7 @@ def evaluate_pair(
         scale, ratio = scale_and_distortion(H, center)
         scales.append(scale)
         ratios.append(ratio)
+        progress(1)
     return before.metrics([], [], fps), after.metrics(scales, ratios, fps)
 
 

@@ -17,7 +17,7 @@ def test_evaluate_command(tmp_path):
                                       f"{sample}/truth.csv", "--json"])  # fmt: skip
     assert result.exit_code == 0, result.output
     assert '"aae_deg": 0.0' in result.output
-    metrics = json.loads(result.output)["stabilised"]
+    metrics = json.loads(result.stdout)["stabilised"]  # (the progress bar is on stderr)
     parts = metrics["shake_components_px"]  # x, y, roll, zoom: their length is the shake
     assert len(parts) == 4 and sum(x * x for x in parts) ** 0.5 == pytest.approx(
         metrics["residual_shake_px"]

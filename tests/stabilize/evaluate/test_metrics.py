@@ -67,6 +67,12 @@ def test_metric_building_blocks():
     assert low_frequency_share(np.sin(2 * np.pi * 20 * t / 64)) < 0.01
 
 
+def test_progress_is_told_of_every_pair_of_frames(shaken):
+    told: list[int] = []
+    evaluate_pair(shaken[:6], shaken[:5], progress=told.append)  # the shorter clip decides
+    assert told == [1] * 5
+
+
 def test_registration_survives_featureless_frames():
     blank = [np.full((90, 160, 3), 128, np.uint8)] * 10
     _, m = evaluate_pair(blank, blank)
