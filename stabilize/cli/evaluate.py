@@ -18,6 +18,7 @@ from stabilize.cli.options import QuietOption
         "Examples:\n\n"
         "  stabilize evaluate shaky.mp4 steady.mp4\n\n"
         "  stabilize evaluate shaky.mp4 vidstab.mp4 --json > metrics.json\n\n"
+        "  stabilize evaluate shaky.mp4 steady.mp4 --plot shake.png\n\n"
         "  stabilize evaluate clip.mp4 out.mp4 --truth truth.csv --rotations rotations.csv\n\n"
         "Residual shake: consecutive frames are registered by a similarity (ORB, RANSAC); "
         "each frame-to-frame motion (dx, dy, and the rotation and zoom as the px they move "
@@ -40,6 +41,9 @@ def evaluate(
         None, help="An estimated rotations file (frame,t,rx,ry,rz,...) to score against --truth."
     ),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON on stdout."),
+    plot: Path | None = typer.Option(
+        None, help="Also draw the shake's parts of both clips over time, and the distortion (PNG)."
+    ),
     quiet: QuietOption = False,
 ) -> None:
     """Cropping ratio, distortion, stability, ITF, residual shake and wobble of a
@@ -50,6 +54,10 @@ def evaluate(
 
     if (truth is None) != (rotations is None):
         fail("--truth and --rotations go together")
+    if plot is not None and plot.suffix.lower() != ".png":
+        fail(f"--plot {plot}: give a .png file")
+    if plot is not None and not plot.parent.is_dir():
+        fail(f"--plot {plot}: no such folder {plot.parent}")
     try:
         info_o, info_s = probe(original), probe(stabilised)
         size = info_o.size
@@ -71,6 +79,12 @@ def evaluate(
             }
     except (VideoError, ValueError) as err:
         fail(str(err))
+    if plot is not None:
+        from stabilize.evaluate.plot import plot_shake
+        from stabilize.video.atomic import atomic_output
+
+        with atomic_output(plot, overwrite=True) as partial:  # (an older one is replaced)
+            plot_shake(partial, before, after, info_o.fps or 30.0)
     if as_json:
         typer.echo(json.dumps(result, indent=2))
         return

@@ -24,7 +24,7 @@ counted).
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import cv2
 import numpy as np
@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 from stabilize.evaluate.shake import (
     MIN_MATCHES,
     MIN_SPREAD,
+    high_passed,
     matched_points,
     principal_spread,
     residual_shake,
@@ -180,9 +181,14 @@ class ClipMetrics:
     # the shake's parts (dx, dy, roll, zoom), px: what is left, and where the metric is noisy
     shake_components_px: tuple[float, float, float, float]
     wobble_px: float  # stabilize.evaluate.wobble: RMS shear and stretch between frames
+    # per pair, what the residual shake is the RMS of (N-1, 4), and per frame the
+    # distortion; for plots (stabilize.evaluate.plot), not in as_dict
+    shake_series: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 4)))
+    distortion_series: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
 
     def as_dict(self) -> dict:
-        return asdict(self)
+        """The figures (not the series)."""
+        return {k: v for k, v in asdict(self).items() if not k.endswith("_series")}
 
 
 class _Clip:
@@ -220,9 +226,8 @@ class _Clip:
     def metrics(self, scales: list[float], ratios: list[float], fps: float) -> ClipMetrics:
         st, sr = stability(self.inter)
         h, w = self.shape[:2] if self.shape else (0, 0)
-        parts = shake_components(
-            np.array(self.motions).reshape(-1, 4), w, fps, ((w - 1) / 2, (h - 1) / 2)
-        )
+        motions, centre = np.array(self.motions).reshape(-1, 4), ((w - 1) / 2, (h - 1) / 2)
+        parts = shake_components(motions, w, fps, centre)
         shake = residual_shake(parts, w)
         return ClipMetrics(
             frames=self.frames,
@@ -237,6 +242,8 @@ class _Clip:
             residual_shake_deg=shake[1],
             shake_components_px=tuple(float(x) for x in parts),
             wobble_px=wobble(np.array(self.skews), w),
+            shake_series=high_passed(motions, w, fps, centre),
+            distortion_series=np.asarray(ratios, np.float64) if ratios else np.ones(self.frames),
         )
 
 

@@ -74,19 +74,15 @@ def similarity_motion(src: NDArray, dst: NDArray, width: int) -> NDArray[np.floa
     return np.array([M[0, 2], M[1, 2], np.arctan2(M[1, 0], M[0, 0]), np.log(scale)])
 
 
-def shake_components(
+def high_passed(
     motions: NDArray, width: int, fps: float, center: tuple[float, float] | None = None
 ) -> NDArray[np.float64]:
-    """The RMS of each high-passed component of v_t, (dx, dy, roll, zoom) in px at the
-    clip's ``width``, of frame-to-frame similarity motions (N, 4) at ``fps``; NaN for
-    fewer than 3. The translation is taken at the frame's ``center`` (the similarity's
-    own is that of the pixel origin, a corner, which a small rotation moves far more than
-    the middle). Which component dominates tells what is left: on a walk past near
-    surfaces the zoom is the similarity fit's choice between depth layers, and differs
-    from one output of the same clip to the next (GoPro hero7: 1.02–1.24 px)."""
-    motions = np.asarray(motions, dtype=np.float64)
-    if len(motions) < 3:
-        return np.full(4, np.nan)
+    """v_t - (G_σ * v)_t (N, 4): what a viewer sees as shake in each frame-to-frame
+    similarity motion (N, 4) at ``fps``, as (dx, dy, roll, zoom) in px at the clip's
+    ``width``. The translation is taken at the frame's ``center`` (the similarity's own
+    is that of the pixel origin, a corner, which a small rotation moves far more than the
+    middle)."""
+    motions = np.asarray(motions, dtype=np.float64).reshape(-1, 4)
     dx, dy, dtheta, dlog = motions.T
     if center is not None:  # the translation of the frame's centre, not of its corner
         cx, cy = center
@@ -94,8 +90,21 @@ def shake_components(
         dx = dx + k * (c * cx - s * cy) - cx
         dy = dy + k * (s * cx + c * cy) - cy
     v = np.stack([dx, dy, dtheta * width / 2, dlog * width / 2], 1)
-    high = v - gaussian_filter1d(v, sigma=max(CUTOFF_S * fps, 1.0), axis=0, mode="nearest")
-    return np.sqrt(np.mean(high**2, axis=0))
+    if len(v) == 0:
+        return v
+    return v - gaussian_filter1d(v, sigma=max(CUTOFF_S * fps, 1.0), axis=0, mode="nearest")
+
+
+def shake_components(
+    motions: NDArray, width: int, fps: float, center: tuple[float, float] | None = None
+) -> NDArray[np.float64]:
+    """The RMS of each :func:`high_passed` component, (dx, dy, roll, zoom) in px; NaN
+    for fewer than 3 motions. Which component dominates tells what is left: on a walk
+    past near surfaces the zoom is the similarity fit's choice between depth layers, and
+    differs from one output of the same clip to the next (GoPro hero7: 1.02–1.24 px)."""
+    if len(motions) < 3:
+        return np.full(4, np.nan)
+    return np.sqrt(np.mean(high_passed(motions, width, fps, center) ** 2, axis=0))
 
 
 def residual_shake(components: NDArray, width: int) -> tuple[float, float]:

@@ -26,3 +26,15 @@ def test_evaluate_command(tmp_path):
     assert text.exit_code == 0 and "x, y, roll, zoom (px)" in text.output
     bad = CliRunner().invoke(app, ["evaluate", "README.md", f"{sample}/clip.mp4"])
     assert bad.exit_code != 0 and "not a video" in bad.output
+
+
+def test_evaluate_draws_the_shake(tmp_path):
+    sample = "samples/street/clip.mp4"
+    png = tmp_path / "shake.png"
+    result = CliRunner().invoke(app, ["evaluate", sample, sample, "--plot", str(png), "-q"])
+    assert result.exit_code == 0, result.output
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
+    wrongs = {"shake.txt": "give a .png file", "no/shake.png": "no such folder"}
+    for wrong, why in wrongs.items():
+        bad = CliRunner().invoke(app, ["evaluate", sample, sample, "--plot", str(tmp_path / wrong)])
+        assert bad.exit_code == 2 and why in bad.output
