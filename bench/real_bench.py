@@ -7,7 +7,8 @@ output, the residual shake (``stabilize evaluate``: the RMS of the high-passed
 frame-to-frame similarity motion, px at the clip's width) and its parts (x, y, roll,
 zoom: on a walk past near surfaces the zoom is the metric's noisiest), the wobble (a rolling
 shutter's shear and stretch between frames, px), stability, cropping,
-distortion and wall time, then the median of ours ÷ vid.stab's residual shake.
+distortion and wall time, then the median of ours ÷ vid.stab's residual shake. Each
+output's shake plot (``stabilize evaluate --plot``) is left beside it.
 
     python bench/real_bench.py                 # the real clips and three rendered walks
     python bench/real_bench.py --fov auto      # our run with the focal length estimated
@@ -27,6 +28,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from stabilize_bench import timed, vidstab
 
 from stabilize.evaluate.metrics import evaluate_pair
+from stabilize.evaluate.plot import plot_shake
 from stabilize.video import ffmpeg_exe, probe, read_frames
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
@@ -83,13 +85,15 @@ def main() -> None:
         fps = info.fps or 30.0
         original, ours_m = evaluate_pair(read_frames(clip), read_frames(mine, info.size), fps)
         _, theirs_m = evaluate_pair(read_frames(clip), read_frames(theirs, info.size), fps)
+        for tool, m in (("ours", ours_m), ("vidstab", theirs_m)):  # what each row is the RMS of
+            plot_shake(work / f"{tag}_{tool}_shake.png", original, m, fps)
         for tool, m, t in (("original", original, None), ("ours", ours_m, t_ours)):
             print(_row(name, tool, m, t))
         print(_row(name, "vid.stab", theirs_m, t_vs))
         ratios.append(ours_m.residual_shake_px / theirs_m.residual_shake_px)
     print(
         f"\nours ÷ vid.stab residual shake: median {statistics.median(ratios):.2f} "
-        f"({', '.join(f'{r:.2f}' for r in ratios)}); outputs in {work}"
+        f"({', '.join(f'{r:.2f}' for r in ratios)}); outputs and their shake plots in {work}"
     )
 
 
