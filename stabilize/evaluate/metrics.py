@@ -74,10 +74,15 @@ class Registrar:
         return pts, desc
 
     def homography(self, a, b, width: int) -> NDArray[np.float64]:
-        """H with b ~ H a, from features() of two frames ``width`` px wide; identity if it
-        cannot be found, or if its inliers spread less than ``MIN_SPREAD`` of the width
-        across their narrowest direction (a strip, which leaves the rest undetermined)."""
-        matched = matched_points(a, b, self.matcher)
+        """H with b ~ H a, from features() of two frames ``width`` px wide
+        (:meth:`fit`)."""
+        return self.fit(matched_points(a, b, self.matcher), width)
+
+    def fit(self, matched: tuple[NDArray, NDArray] | None, width: int) -> NDArray[np.float64]:
+        """H with dst ~ H src of matched points (src, dst) in frames ``width`` px wide;
+        identity, counted as a failure, if it cannot be found, or if its inliers spread
+        less than ``MIN_SPREAD`` of the width across their narrowest direction (a strip,
+        which leaves the rest undetermined)."""
         if matched is not None:
             H, mask = cv2.findHomography(*matched, cv2.USAC_MAGSAC, 1.5)
             if H is not None and mask.sum() >= MIN_MATCHES:
@@ -210,8 +215,8 @@ class _Clip:
         grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         if self.previous is not None:
             width = frame.shape[1]
-            self.inter.append(self.reg.homography(self.previous[0], feat, width))
-            matched = matched_points(self.previous[0], feat, self.reg.matcher)
+            matched = matched_points(self.previous[0], feat, self.reg.matcher)  # once, for both
+            self.inter.append(self.reg.fit(matched, width))
             motion = None if matched is None else similarity_motion(*matched, width)
             self.motions.append(np.zeros(4) if motion is None else motion)
             if not np.array_equal(self.inter[-1], np.eye(3)):  # registered
