@@ -60,12 +60,12 @@ def evaluate(
         fail(f"--plot {plot}: no such folder {plot.parent}")
     try:
         info_o, info_s = probe(original), probe(stabilised)
-        size = info_o.size
+        size, fps = info_o.size, info_o.fps or 30.0
         with progress_bar("evaluating", None, quiet=quiet) as advance:
             before, after = evaluate_pair(
                 read_frames(original, info=info_o),
                 read_frames(stabilised, size, info_s),
-                info_o.fps or 30.0,
+                fps,
                 advance,
             )
         result = {"original": before.as_dict(), "stabilised": after.as_dict()}
@@ -84,7 +84,7 @@ def evaluate(
         from stabilize.video.atomic import atomic_output
 
         with atomic_output(plot, overwrite=True) as partial:  # (an older one is replaced)
-            plot_shake(partial, before, after, info_o.fps or 30.0)
+            plot_shake(partial, before, after, fps)
     if as_json:
         typer.echo(json.dumps(result, indent=2))
         return

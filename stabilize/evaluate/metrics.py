@@ -35,9 +35,9 @@ from stabilize.evaluate.shake import (
     MIN_SPREAD,
     high_passed,
     matched_points,
+    parts_of,
     principal_spread,
     residual_shake,
-    shake_components,
     similarity_motion,
 )
 from stabilize.evaluate.wobble import non_similar_part, wobble
@@ -232,7 +232,8 @@ class _Clip:
         st, sr = stability(self.inter)
         h, w = self.shape[:2] if self.shape else (0, 0)
         motions, centre = np.array(self.motions).reshape(-1, 4), ((w - 1) / 2, (h - 1) / 2)
-        parts = shake_components(motions, w, fps, centre)
+        series = high_passed(motions, w, fps, centre)
+        parts = parts_of(series)
         shake = residual_shake(parts, w)
         return ClipMetrics(
             frames=self.frames,
@@ -247,7 +248,7 @@ class _Clip:
             residual_shake_deg=shake[1],
             shake_components_px=tuple(float(x) for x in parts),
             wobble_px=wobble(np.array(self.skews), w),
-            shake_series=high_passed(motions, w, fps, centre),
+            shake_series=series,
             distortion_series=np.asarray(ratios, np.float64) if ratios else np.ones(self.frames),
         )
 

@@ -98,13 +98,19 @@ def high_passed(
 def shake_components(
     motions: NDArray, width: int, fps: float, center: tuple[float, float] | None = None
 ) -> NDArray[np.float64]:
-    """The RMS of each :func:`high_passed` component, (dx, dy, roll, zoom) in px; NaN
-    for fewer than 3 motions. Which component dominates tells what is left: on a walk
-    past near surfaces the zoom is the similarity fit's choice between depth layers, and
-    differs from one output of the same clip to the next (GoPro hero7: 1.02–1.24 px)."""
-    if len(motions) < 3:
+    """The RMS of each :func:`high_passed` component, (dx, dy, roll, zoom) in px
+    (:func:`parts_of`)."""
+    return parts_of(high_passed(motions, width, fps, center))
+
+
+def parts_of(high: NDArray) -> NDArray[np.float64]:
+    """The RMS of each component of a :func:`high_passed` series (N, 4); NaN for fewer
+    than 3 motions. Which component dominates tells what is left: on a walk past near
+    surfaces the zoom is the similarity fit's choice between depth layers, and differs
+    from one output of the same clip to the next (GoPro hero7: 1.02–1.24 px)."""
+    if len(high) < 3:
         return np.full(4, np.nan)
-    return np.sqrt(np.mean(high_passed(motions, width, fps, center) ** 2, axis=0))
+    return np.sqrt(np.mean(np.asarray(high) ** 2, axis=0))
 
 
 def residual_shake(components: NDArray, width: int) -> tuple[float, float]:
