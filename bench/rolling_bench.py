@@ -1,10 +1,11 @@
 """Rolling shutter without a gyro: the readout found from the video, and the wobble left.
 
 Rendered street clips (540×960, 4 s, 3° RMS shake: 1–3° a frame) with readouts of 0, 15,
-25 and 33 ms are stabilised twice, with ``--rolling-shutter auto`` (the default) and
-``off``, at the true field of view; the table gives the readout found, its uncertainty,
-the residual shake and the wobble (``stabilize evaluate``) of each output, and the
-wobble's ratio. phone-cc9's frames, whose gyro gives a 25.4 ms readout
+25 and 33 ms are stabilised three times at the true field of view: with
+``--rolling-shutter auto`` (the default: the correction within ``--max-stretch`` 0.8%),
+with the whole correction (``--max-stretch 100``), and ``off``; the table gives the
+readout found, its uncertainty, and the residual shake, the wobble and the distortion
+(``stabilize evaluate``) of each output. phone-cc9's frames, whose gyro gives a 25.4 ms readout
 (``stabilize compare``), are run at their focal length, 573.85 px.
 
     python bench/rolling_bench.py
@@ -29,12 +30,19 @@ PHONE = Path(__file__).resolve().parents[2] / "shared" / "data" / "phone-cc9" / 
 PHONE_FOCAL = "573.85"
 
 
-def stabilise(clip: Path, out: Path, shutter: str, lens: list[str]) -> tuple[dict, float]:
+VARIANTS = {  # the three runs of each clip
+    "auto": ["--rolling-shutter", "auto"],
+    "whole": ["--rolling-shutter", "auto", "--max-stretch", "100"],
+    "off": ["--rolling-shutter", "off"],
+}
+
+
+def stabilise(clip: Path, out: Path, options: list[str], lens: list[str]) -> tuple[dict, float]:
     """Our run's summary and wall time."""
     cmd = [sys.executable, "-m", "stabilize.cli", "run", str(clip), str(out), "-q", "--json"]
     start = time.perf_counter()
     done = subprocess.run(
-        [*cmd, "--overwrite", "--rolling-shutter", shutter, *lens],
+        [*cmd, "--overwrite", *options, *lens],
         check=True,
         capture_output=True,
         text=True,
@@ -67,15 +75,15 @@ def main() -> None:
     if PHONE.is_dir():
         runs.append(("phone-cc9 (gyro: 25.4 ms)", phone_clip(work), ["--focal", PHONE_FOCAL]))
     print(
-        f"{'clip':28s}{'readout found':>24s}{'shake auto/off':>17s}{'wobble auto/off':>18s}"
-        f"{'ratio':>7s}{'s auto/off':>13s}"
+        f"{'clip':28s}{'readout found':>26s}{'shake auto/whole/off':>22s}"
+        f"{'wobble auto/whole/off':>23s}{'distortion auto/whole/off':>27s}{'s auto/off':>12s}"
     )
     for name, clip, lens in runs:
         info = probe(clip)
         found, seconds, metrics = None, [], []
-        for shutter in ("auto", "off"):
-            out = work / f"{clip.parent.name}-{clip.stem}-{shutter}.mp4"
-            summary, t = stabilise(clip, out, shutter, lens)
+        for variant, options in VARIANTS.items():
+            out = work / f"{clip.parent.name}-{clip.stem}-{variant}.mp4"
+            summary, t = stabilise(clip, out, options, lens)
             found = found or summary["rolling_shutter"]
             seconds.append(t)
             _, after = evaluate_pair(read_frames(clip, info=info), read_frames(out, info.size))
@@ -83,10 +91,12 @@ def main() -> None:
         estimate = found["estimate_ms"]
         told = "-" if estimate is None else f"{estimate:.1f} ± {found['stderr_ms']:.1f} ms"
         told = f"{told} ({found['source']}{', used' if found['readout_ms'] else ''})"
-        (a, b), (wa, wb) = ((m.residual_shake_px for m in metrics), (m.wobble_px for m in metrics))
+        shake = "/".join(f"{m.residual_shake_px:.3f}" for m in metrics)
+        wobble = "/".join(f"{m.wobble_px:.3f}" for m in metrics)
+        distortion = "/".join(f"{m.distortion:.3f}" for m in metrics)
         print(
-            f"{name:28s}{told:>24s}{a:>9.3f}/{b:<7.3f}{wa:>10.3f}/{wb:<7.3f}{wa / wb:>7.2f}"
-            f"{seconds[0]:>7.1f}/{seconds[1]:<5.1f}"
+            f"{name:28s}{told:>26s}{shake:>22s}{wobble:>23s}{distortion:>27s}"
+            f"{seconds[0]:>7.1f}/{seconds[-1]:<5.1f}"
         )
     print(f"\noutputs in {work}")
 

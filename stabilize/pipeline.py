@@ -40,7 +40,7 @@ from stabilize.path.smoothing import METHODS
 from stabilize.path.zoom import CROP_MODES
 from stabilize.progress import ProgressFactory, no_progress
 from stabilize.settings import Settings
-from stabilize.video import VideoInfo, atomic_output, frame_times, probe
+from stabilize.video import VideoInfo, atomic_output, frame_interval, frame_times, probe
 from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Mux
 from stabilize.video.preflight import check_encoder, check_writable, describe
@@ -48,6 +48,7 @@ from stabilize.video.streams import keep_streams
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.lens import Lens, read_lens_profile
 from stabilize.warp.render import encoded_size, frame_size, render
+from stabilize.warp.rolling import RAMP_S, within_stretch
 
 
 @dataclass(frozen=True)
@@ -90,7 +91,7 @@ def stabilize_video(
     start = time.perf_counter()
     bar = progress or (lambda label, total: no_progress)
     track, focal, rotations = _motion(src, job, settings, bar, tell)
-    R, rolling, residual, repaired, gyro_summary, shutter = rotations
+    R, rolling, residual, repaired, gyro_summary, shutter, eased = rotations
     t_estimate = time.perf_counter() - start
     K = _camera_matrix(focal.px, job.info, job.lens)
     planned = plan_path(
@@ -122,6 +123,7 @@ def stabilize_video(
         "settings": settings_summary(settings),
         "gyro": gyro_summary,
         "rolling_shutter": None if shutter is None else shutter.summary(),
+        "stretch_eased_frames": eased,  # rolling-shutter corrections kept within --max-stretch
         "notices": list(job.notices),
     }
     return summary, planned
@@ -193,18 +195,19 @@ def _motion(src: Path, job: Job, settings: Settings, bar, tell) -> tuple:
     )
     if focal.note:
         tell(f"focal length: {focal.note}")
-    rotations = _rotations(settings, job, track, focal.px)
-    shutter = rotations[-1]
-    if shutter is not None and shutter.source != "off":
-        tell(f"rolling shutter: {shutter.describe()}")
-    return track, focal, rotations
+    return track, focal, _rotations(settings, job, track, focal.px, tell)
 
 
-def _rotations(settings: Settings, job: Job, track: VisualTrack, focal: float) -> tuple:
+def _rotations(
+    settings: Settings, job: Job, track: VisualTrack, focal: float, tell: Callable[[str], None]
+) -> tuple:
     """(R_t, rolling-shutter turns or None, the similarities R_t leaves, frames repaired,
-    gyro summary or None, the visual readout or None): from the gyro log when there is
+    gyro summary or None, the visual readout or None, frames whose row turns were
+    eased): from the gyro log when there is
     one, else the visual track with unreliable frames repaired (and no residual motion on
-    them); under a rolling shutter, the rotations between the frames' middle rows."""
+    them); under a rolling shutter, the rotations between the frames' middle rows, and
+    the row turns eased where they would stretch a frame past the budget
+    (:func:`stabilize.warp.rolling.within_stretch`)."""
     reliable = np.ones(len(track.rotations), bool)
     shutter = None
     if job.log is not None:
@@ -219,9 +222,22 @@ def _rotations(settings: Settings, job: Job, track: VisualTrack, focal: float) -
         from stabilize.shutter import readout_for, visual_rolling_shutter
 
         shutter, spline = readout_for(settings.rolling_shutter, track)
+        if shutter is not None and shutter.source != "off":
+            tell(f"rolling shutter: {shutter.describe()}")
         if spline is not None:
             R, rolling = visual_rolling_shutter(
                 spline, track.times, shutter.seconds, job.info.height
+            )
+    eased = 0
+    if rolling is not None:
+        K = _camera_matrix(focal, job.info, job.lens)
+        ramp = round(RAMP_S / frame_interval(track.times))
+        limit = settings.max_stretch
+        rolling, eased = within_stretch(rolling, K, ramp, 1 - limit / 100)
+        if eased:
+            tell(
+                f"rolling shutter: the correction eased on {eased} of {len(track.times)} "
+                f"frames, which it would have stretched by over {limit:g}% (--max-stretch)"
             )
     residual = track.residual
     if residual is not None and shutter is not None and rolling is not None:
@@ -232,7 +248,7 @@ def _rotations(settings: Settings, job: Job, track: VisualTrack, focal: float) -
         residual = reexpress(residual, track.rotations, R, focal, job.info.size)
     if residual is not None:
         residual = np.where(reliable[:, None], residual, 0.0)
-    return R, rolling, residual, int((~reliable).sum()), summary, shutter
+    return R, rolling, residual, int((~reliable).sum()), summary, shutter, eased
 
 
 def _write(
@@ -269,6 +285,7 @@ def check_settings(settings: Settings) -> None:
         (settings.smooth > 0, "--smooth must be positive"),
         (settings.max_zoom >= 1.0, "--max-zoom must be at least 1"),
         (settings.gyro_search >= 0, "--gyro-search must not be negative"),
+        (0 <= settings.max_stretch <= 100, "--max-stretch must be 0–100 %"),
         (
             settings.rolling_shutter in ("auto", "off")
             or (

@@ -25,6 +25,7 @@ from stabilize.cli.options import (
     GyroSearchOption,
     LensOption,
     LockOption,
+    MaxStretchOption,
     MaxZoomOption,
     MethodOption,
     MotionOption,
@@ -92,6 +93,7 @@ def batch(
     gyro_drift: GyroDriftOption = DEFAULTS.gyro_drift,
     readout_ms: ReadoutOption = None,
     rolling_shutter: RollingShutterOption = str(DEFAULTS.rolling_shutter),
+    max_stretch: MaxStretchOption = DEFAULTS.max_stretch,
     quiet: QuietOption = False,
 ) -> None:
     """Stabilise every clip in a folder: resumable, one failure never stops the rest."""

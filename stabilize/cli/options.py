@@ -139,6 +139,17 @@ ReadoutOption = Annotated[
         "Default: the log's own value, else none."
     ),
 ]
+MaxStretchOption = Annotated[
+    float,
+    typer.Option(
+        "--max-stretch",
+        min=0.0,
+        max=100.0,
+        help="The most the rolling-shutter correction may shear or stretch a frame, %; "
+        "a frame whose rows turned further is corrected less (ramped over 0.15 s). "
+        "100: no limit.",
+    ),
+]
 RollingShutterOption = Annotated[
     str,
     typer.Option(
@@ -186,6 +197,7 @@ def job_settings(params: Mapping[str, Any]) -> Settings:
         gyro_lpf=params["gyro_lpf"],
         readout_ms=readout(params["readout_ms"], gyro, shutter),
         rolling_shutter=shutter,
+        max_stretch=params.get("max_stretch", DEFAULTS.max_stretch),
         gyro_drift=params["gyro_drift"],
         lens=str(lens) if lens else None,
         gyro_format=params["gyro_format"],

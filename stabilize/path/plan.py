@@ -22,6 +22,7 @@ from stabilize.path.optimal import optimal_path
 from stabilize.path.smoothing import orientations_from_rotations, smooth_orientations
 from stabilize.path.zoom import CROP_MODES, choose_zoom
 from stabilize.settings import Settings
+from stabilize.video.decode import frame_interval
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.coverage import CORNERS, Framing
 from stabilize.warp.homography import homography
@@ -82,7 +83,7 @@ def plan_path(
         need = np.ones(len(O))
     elif over(path, everything).any():
         parts = planar.MOTION_MODELS[settings.motion] if measured else ()
-        ceiling, sigma = _ceiling(raw, path, parts), settings.smooth / _frame_interval(times)
+        ceiling, sigma = _ceiling(raw, path, parts), settings.smooth / frame_interval(times)
         solved = optimal_path(path, sources, size, parts, CORNERS, ceiling, sigma)
         if solved is not None:
             path, need = solved, zoom_of(solved, everything)
@@ -108,8 +109,3 @@ def _ceiling(raw: Trajectory, path: Trajectory, parts: tuple[int, ...]) -> NDArr
     if 3 in parts:
         ceiling[:, 3 + parts.index(3)] = raw.shift[:, 3] - path.shift[:, 3]
     return ceiling
-
-
-def _frame_interval(times: NDArray) -> float:
-    """The median frame interval, s (1/30 for a single frame)."""
-    return float(np.median(np.diff(times))) if len(times) > 1 else 1 / 30

@@ -6,7 +6,7 @@ writes video through these names.
 
 from stabilize.video.atomic import atomic_output
 from stabilize.video.binary import ffmpeg_exe
-from stabilize.video.decode import frame_times, read_frames
+from stabilize.video.decode import frame_interval, frame_times, read_frames
 from stabilize.video.encode import Encoding, FrameWriter
 from stabilize.video.probe import VideoError, VideoInfo, probe, sequence_args
 from stabilize.video.retime import is_variable_rate, retime
@@ -18,6 +18,7 @@ __all__ = [
     "VideoInfo",
     "atomic_output",
     "ffmpeg_exe",
+    "frame_interval",
     "frame_times",
     "is_variable_rate",
     "probe",

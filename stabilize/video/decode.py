@@ -86,6 +86,11 @@ def frame_times(path: str | Path, input_args: tuple = ()) -> np.ndarray:
     return times - times[0]
 
 
+def frame_interval(times: np.ndarray) -> float:
+    """The median interval between frame ``times``, s (1/30 for a single frame)."""
+    return float(np.median(np.diff(times))) if len(times) > 1 else 1 / 30
+
+
 def _framecrc_times(path: str | Path, input_args: tuple, *, decode: bool) -> np.ndarray | None:
     """Sorted frame times from FFmpeg's framecrc of the first video stream: its packets
     (``decode`` False) or its decoded frames; None where some carry no timestamp."""

@@ -77,6 +77,8 @@ CASES = {
     "readout not a number": Case(("--gyro", str(LOG), "--readout-ms", "fast"), 2),
     "rolling shutter not a number": Case(("--rolling-shutter", "fast"), 2),
     "rolling shutter too long": Case(("--rolling-shutter", "2000"), 2),
+    "stretch over 100 %": Case(("--max-stretch", "150"), 2),
+    "stretch negative": Case(("--max-stretch", "-1"), 2),
     "rolling shutter and readout": Case(
         ("--gyro", str(LOG), "--readout-ms", "5", "--rolling-shutter", "5"), 2
     ),

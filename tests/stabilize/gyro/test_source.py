@@ -114,7 +114,7 @@ def test_rolling_shutter_correction_from_the_gyro(tmp_path):
     args = ["run", str(SAMPLE / "clip.mp4"), str(out), "--gyro", str(SAMPLE / "gyro.csv")]
     result = CliRunner().invoke(app, [*args, "--fov", "70", "--readout-ms", "20", "-q", "--json"])
     assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)  # notices go to stderr
     assert summary["gyro"]["readout_ms"] == 20.0 and summary["frames"] == 90
     # Given a readout, the offset found is the first row's: the content's (0.35 s, a global
     # shutter) minus the readout times the mean height of the vectors, which is 0..1.

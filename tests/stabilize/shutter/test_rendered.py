@@ -22,10 +22,10 @@ def rendered(folder: Path, readout_ms: float) -> Path:
     return folder / "clip.mp4"
 
 
-def wobble(original: Path, output: Path) -> float:
+def measured(original: Path, output: Path):
     info = probe(original)
     _, after = evaluate_pair(read_frames(original, info=info), read_frames(output, info.size))
-    return after.wobble_px
+    return after
 
 
 @pytest.fixture(scope="module")
@@ -34,7 +34,7 @@ def jello(tmp_path_factory) -> Path:
 
 
 def test_the_readout_is_found_and_the_wobble_undone(jello, tmp_path):
-    settings = Settings(fov=70.0, max_zoom=1.3)
+    settings = Settings(fov=70.0, max_zoom=1.3, max_stretch=100.0)  # the whole correction
     summary, planned = stabilize_video(jello, tmp_path / "auto.mp4", settings)
     found = summary["rolling_shutter"]
     assert found["source"] == "estimated" and found["readout_ms"] == pytest.approx(25.0, abs=2.5)
@@ -44,10 +44,26 @@ def test_the_readout_is_found_and_the_wobble_undone(jello, tmp_path):
     assert summary_off["rolling_shutter"]["source"] == "off"
     assert planned_off.row_corrections is None
     corrected, uncorrected = (
-        wobble(jello, tmp_path / "auto.mp4"),
-        wobble(jello, tmp_path / "off.mp4"),
+        measured(jello, tmp_path / "auto.mp4").wobble_px,
+        measured(jello, tmp_path / "off.mp4").wobble_px,
     )
     assert corrected < 0.4 * uncorrected
+
+
+def test_the_correction_stretches_no_frame_past_the_budget(jello, tmp_path):
+    # 3° of shake a frame under a 25 ms readout: undoing the rows' turns whole would
+    # shear frames by several %, which the metric reads as distortion
+    whole = Settings(fov=70.0, max_zoom=1.3, max_stretch=100.0)
+    told: list[str] = []
+    assert stabilize_video(jello, tmp_path / "whole.mp4", whole)[0]["stretch_eased_frames"] == 0
+    summary, _ = stabilize_video(
+        jello, tmp_path / "eased.mp4", Settings(fov=70.0, max_zoom=1.3), notify=told.append
+    )
+    assert summary["stretch_eased_frames"] > 0
+    assert any("eased" in line and "--max-stretch" in line for line in told)
+    eased, full = measured(jello, tmp_path / "eased.mp4"), measured(jello, tmp_path / "whole.mp4")
+    assert full.distortion < 0.97
+    assert eased.distortion > 0.985
 
 
 def test_a_global_shutter_clip_is_left_alone(tmp_path):
