@@ -92,14 +92,15 @@ def within_stretch(
     from rotation.so3 import exp_so3, log_so3
 
     slopes = centre_slopes(rolling, K)
-    if len(slopes) == 0 or stretch(slopes).min() >= floor:
+    whole = stretch(slopes)
+    if len(slopes) == 0 or whole.min() >= floor:
         return rolling, 0
     lo, hi = np.zeros(len(slopes)), np.ones(len(slopes))
     for _ in range(24):  # λ to 1e-7
         mid = 0.5 * (lo + hi)
         good = stretch(slopes * mid[:, None]) >= floor
         lo, hi = np.where(good, mid, lo), np.where(good, hi, mid)
-    lam = np.where(stretch(slopes) >= floor, 1.0, lo)
+    lam = np.where(whole >= floor, 1.0, lo)
     width = 2 * max(int(ramp), 0) + 1
     lam = uniform_filter1d(minimum_filter1d(lam, width, mode="nearest"), width, mode="nearest")
     n, b = rolling.turns.shape[:2]
