@@ -26,6 +26,7 @@ from rotation import so3
 from stabilize.gyro.axes import signed_permutations
 from stabilize.gyro.log import GyroError, GyroLog
 from stabilize.motion.track import MIN_BAND_SUPPORT, VisualTrack
+from stabilize.video.decode import frame_interval
 
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 MIN_CORRELATION = 0.6  # of angular speeds, below which a log does not match the video
@@ -146,7 +147,7 @@ def coarse_offset(
     lo, hi = gyro.log.span
     first, last = float(times[0]), float(times[-1])
     if hi - lo >= MIN_COVERAGE * (last - first):
-        step = 0.25 * float(np.median(np.diff(times)))
+        step = 0.25 * frame_interval(times)
         coarse = _best_offset(gyro, times, w_vis, np.arange(lo - first, hi - last + step, step))
         if np.isfinite(coarse[1]):
             fine = np.arange(coarse[0] - step, coarse[0] + step + 5e-4, 1e-3)
@@ -262,7 +263,7 @@ def estimate_readout(
     too uncertain (smooth, slow motion dates the bands poorly), the answer is None and
     ``offset`` is returned unchanged.
     """
-    frame = float(np.median(np.diff(track.times)))
+    frame = frame_interval(track.times)
     heights, offsets, weights = [], [], []
     for R_b, rows, support in zip(track.bands, track.band_rows, track.band_support, strict=True):
         if np.median(support) < MIN_BAND_SUPPORT:

@@ -29,6 +29,7 @@ from rotation import so3
 from stabilize.gyro.integrate import Attitude, attitude
 from stabilize.gyro.log import GyroLog
 from stabilize.motion.track import MIN_BAND_SUPPORT, VisualTrack
+from stabilize.video.decode import frame_interval
 
 BEND = 1e-3  # weight of the coefficients' second differences (rad², against the data's)
 IRLS_STEPS = 3
@@ -73,7 +74,7 @@ class Spline:
 def knots_for(times: NDArray) -> NDArray[np.float64]:
     """Clamped cubic knots a frame interval apart, reaching a frame interval before the
     first frame and two past the last (the bottom rows of the last pair)."""
-    step = float(np.median(np.diff(times)))
+    step = frame_interval(times)
     inner = np.arange(times[0] - step, times[-1] + 2.5 * step, step)
     return np.r_[[inner[0]] * 3, inner, [inner[-1]] * 3]
 
@@ -109,6 +110,6 @@ def visual_attitude(spline: Spline, times: NDArray) -> Attitude:
     """The attitude G(t) the spline's rates integrate to, sampled ``RATE_SAMPLES`` times
     a frame interval over the knots' span (video clock)."""
     lo, hi = spline.knots[0], spline.knots[-1]
-    count = int(np.ceil((hi - lo) / float(np.median(np.diff(times))) * RATE_SAMPLES)) + 1
+    count = int(np.ceil((hi - lo) / frame_interval(times) * RATE_SAMPLES)) + 1
     at = np.linspace(lo, hi, count)
     return attitude(GyroLog(at, spline.rates(at), "the video"))

@@ -24,6 +24,7 @@ from rotation import so3
 from stabilize.gyro.sync import golden_section
 from stabilize.motion.track import VisualTrack
 from stabilize.shutter.attitude import Bands, Spline, fit_attitude, knots_for
+from stabilize.video.decode import frame_interval
 
 GRID = 29  # readouts tried across -0.2..1.2 frame intervals
 MAX_SEARCH_PAIRS = 900  # pairs the readout is searched on (30 s at 30 fps)
@@ -93,7 +94,7 @@ def estimate_readout(track: VisualTrack) -> tuple[Readout, Spline | None]:
     where refused or 0). A long clip's readout is searched on its ``MAX_SEARCH_PAIRS``
     most shaking consecutive pairs (the search's time grows with the length: 1.5 s for a
     minute), and the attitude is then fitted to the whole clip once."""
-    frame = float(np.median(np.diff(track.times)))
+    frame = frame_interval(track.times)
     first = _most_shaking(track, MAX_SEARCH_PAIRS)
     searched = track.pairs(first, first + MAX_SEARCH_PAIRS) if first is not None else track
     bands = Bands.of(searched)
