@@ -13,8 +13,8 @@ output's shake plot (``stabilize evaluate --plot``) is left beside it.
 ``--spread`` also reads each output mirrored left-right, upside down and both: the same
 motion, so the same shake, but other features and other RANSAC draws. The range of the
 four readings is the metric's own uncertainty on that clip, which a difference between
-the tools must exceed to mean anything (max-heromode: ours 0.931–1.016, vid.stab
-0.944–1.009; hero7: 1.268–1.296 against 1.118–1.194), and their mean a steadier reading;
+the tools must exceed to mean anything (max-heromode: ours 0.921–0.988, vid.stab
+0.944–1.009; hero7: 1.305–1.335 against 1.118–1.194), and their mean a steadier reading;
 the median ratio is then given of the means too.
 
     python bench/real_bench.py                 # the real clips and three rendered walks

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stabilize.video.binary import ffmpeg_exe, widen_pipe
+from stabilize.video.colour import UNKNOWN, Colour
 from stabilize.video.containers import Container, container_for
 from stabilize.video.encoders import encoder_args
 from stabilize.video.i420 import pipe_layout
@@ -85,7 +86,9 @@ def _delayed(delay: float) -> list[str]:
 
 class FrameWriter:
     """Streams RGB uint8 frames (or I420, with ``pix_fmt_in="yuv420p"``) into an encoder
-    process at a constant frame rate ``fps``, muxed with what ``mux`` adds."""
+    process at a constant frame rate ``fps``, muxed with what ``mux`` adds, tagged with the
+    source's ``colour`` (I420 frames are taken to be in it already; RGB ones are
+    converted to it)."""
 
     def __init__(
         self,
@@ -97,18 +100,25 @@ class FrameWriter:
         *,
         pix_fmt_in: str = "rgb24",
         container: Container | None = None,
+        colour: Colour | None = None,
     ) -> None:
         encoding, mux = encoding or Encoding(), mux or Mux()
+        tags = (colour or UNKNOWN).ffmpeg_args()
         h, w = size
         self.path = Path(path)
         self.shape, self.dtype = pipe_layout(pix_fmt_in, size)
         raw = ["-f", "rawvideo", "-pix_fmt", pix_fmt_in, "-s", f"{w}x{h}", "-framerate", str(fps)]
         cmd = [ffmpeg_exe(), "-hide_banner", "-loglevel", "error", "-nostdin", "-y"]
-        cmd += [*raw, "-i", "pipe:"]
+        # YUV samples are the source's own: stated on the pipe, they are not converted.
+        # RGB ones have no range or matrix, but FFmpeg drops primaries and transfer that
+        # the output alone states when it converts.
+        rgb = Colour(primaries=colour.primaries, transfer=colour.transfer) if colour else None
+        given = tags if pix_fmt_in.startswith("yuv") else (rgb or UNKNOWN).ffmpeg_args()
+        cmd += [*raw, *given, "-i", "pipe:"]
         for extra in mux.inputs:
             cmd += list(extra)
         cmd += ["-map", "0:v", *mux.args, *_delayed(mux.video_delay)]
-        cmd += [*output_args(path, encoding, container), str(path)]
+        cmd += [*output_args(path, encoding, container), *tags, str(path)]
         self._process = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
         widen_pipe(self._process.stdin)
 

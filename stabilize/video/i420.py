@@ -16,12 +16,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 BLACK = (16, 128, 128)  # limited-range black: Y, U, V (8 bits; ×4 at 10 bits)
+FULL_RANGE_BLACK = (0, 128, 128)
 
 
-def black(frame: NDArray) -> tuple[int, int, int]:
-    """Black for a frame's sample depth (uint16 frames carry 10 bits)."""
+def black(frame: NDArray, full_range: bool = False) -> tuple[int, int, int]:
+    """Black for a frame's sample depth (uint16 frames carry 10 bits) and range."""
     scale = 4 if frame.dtype == np.uint16 else 1
-    return tuple(v * scale for v in BLACK)
+    return tuple(v * scale for v in (FULL_RANGE_BLACK if full_range else BLACK))
 
 
 def pipe_format(source_pix_fmt: str) -> str:

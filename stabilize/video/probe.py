@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from stabilize.video.binary import ffmpeg_exe
+from stabilize.video.colour import UNKNOWN, Colour, colour_of
 
 
 class VideoError(ValueError):
@@ -49,6 +50,7 @@ class VideoInfo:
     start: float = 0.0  # the container's start time, s: its earliest stream's first timestamp
     chapters: int = 0
     metadata: str = ""  # the file's own tags as FFmpeg lists them (before its streams)
+    colour: Colour = UNKNOWN  # range, matrix, primaries, transfer: kept in the output
 
     @property
     def size(self) -> tuple[int, int]:
@@ -68,7 +70,9 @@ class VideoInfo:
         return tuple(s for s in self.streams if s.kind == kind)
 
 
-_VIDEO = re.compile(r"Stream #\S+.*?: Video: (\w+).*?, (\w+)(?:\([^)]*\))?, .*?(\d{2,5})x(\d{2,5})")
+_VIDEO = re.compile(
+    r"Stream #\S+.*?: Video: (\w+).*?, (\w+)(?:\(([^)]*)\))?, .*?(\d{2,5})x(\d{2,5})"
+)
 _FPS = re.compile(r"(\d+(?:\.\d+)?) (?:fps|tbr)")
 _DURATION = re.compile(r"Duration: (\d+):(\d+):(\d+(?:\.\d+)?)")
 _START = re.compile(r"Duration: [^\n]*?start: (-?\d+(?:\.\d+)?)")
@@ -127,7 +131,7 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     video = _VIDEO.search(text)
     if video is None:
         raise VideoError(f"{path}: not a video FFmpeg can read")
-    codec, pix_fmt, w, h = video.group(1), video.group(2), int(video.group(3)), int(video.group(4))
+    codec, pix_fmt, w, h = video.group(1), video.group(2), int(video.group(4)), int(video.group(5))
     stream_line = text[video.start() : text.find("\n", video.start())]
     fps_match = _FPS.search(stream_line)
     fps = float(fps_match.group(1)) if fps_match else 0.0
@@ -157,4 +161,5 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
         float(start.group(1)) if start else 0.0,
         len(re.findall(r"^\s+Chapter #", text, re.M)),
         text[: text.find("Stream #")],
+        colour_of(pix_fmt, video.group(3) or ""),
     )

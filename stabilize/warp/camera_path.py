@@ -57,17 +57,24 @@ class CameraPath:
         return self.lens is None and self.row_corrections is None
 
     def warp_many(
-        self, batch: Sequence[tuple[int, NDArray[np.uint8]]], device: str = "cpu"
+        self,
+        batch: Sequence[tuple[int, NDArray[np.uint8]]],
+        device: str = "cpu",
+        full_range: bool = False,
     ) -> list[NDArray[np.uint8]]:
-        """Output frames of (k, frame) pairs, RGB or I420 (2-D); on CUDA the batch is
-        warped together (by homographies, or by the lens's or the rows' maps)."""
+        """Output frames of (k, frame) pairs, RGB or I420 (2-D; ``full_range``: its
+        black); on CUDA the batch is warped together (by homographies, or by the lens's or
+        the rows' maps)."""
         eight_bit = all(frame.dtype == np.uint8 for _, frame in batch)
         if not (device.startswith("cuda") and eight_bit):
-            return [self.warp(k, frame) for k, frame in batch]
-        return self.warp_together(batch, device)
+            return [self.warp(k, frame, full_range) for k, frame in batch]
+        return self.warp_together(batch, device, full_range)
 
     def warp_together(
-        self, batch: Sequence[tuple[int, NDArray[np.uint8]]], device: str
+        self,
+        batch: Sequence[tuple[int, NDArray[np.uint8]]],
+        device: str,
+        full_range: bool = False,
     ) -> list[NDArray[np.uint8]]:
         """8-bit (k, frame) pairs warped as one batch with torch on ``device``."""
         frames = np.stack([frame for _, frame in batch])
@@ -89,7 +96,7 @@ class CameraPath:
         if frames.ndim == 4:
             return list(warp(frames, 0, 0))
         planes = [np.stack(p) for p in zip(*(i420.split(f) for f in frames), strict=True)]
-        fills = i420.black(frames)
+        fills = i420.black(frames, full_range)
         warped = [warp(p, i, fill) for i, (p, fill) in enumerate(zip(planes, fills, strict=True))]
         return [i420.join(*parts) for parts in zip(*warped, strict=True)]
 
@@ -101,11 +108,12 @@ class CameraPath:
             return lens_source(self.lens, C, self.zoom[k], self.knot_rows)
         return rolling_source(homography(self.K, C, self.zoom[k]), self.knot_rows)
 
-    def warp(self, k: int, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
-        """Frame k of the output, from frame k of the input (RGB, or I420 when 2-D)."""
+    def warp(self, k: int, frame: NDArray[np.uint8], full_range: bool = False) -> NDArray[np.uint8]:
+        """Frame k of the output, from frame k of the input (RGB, or I420 when 2-D, whose
+        black depends on its range)."""
         planar = frame.ndim == 2
         if self.plain:
             H = self.homographies[k]
-            return warp_planes(frame, H) if planar else warp_frame(frame, H)
+            return warp_planes(frame, H, full_range) if planar else warp_frame(frame, H)
         source = self.source(k)
-        return remap_planes(frame, source) if planar else remap_from(frame, source)
+        return remap_planes(frame, source, full_range) if planar else remap_from(frame, source)

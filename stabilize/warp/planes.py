@@ -25,27 +25,30 @@ def chroma_homography(H: NDArray) -> NDArray[np.float64]:
     return HALF @ np.asarray(H) @ np.linalg.inv(HALF)
 
 
-def warp_planes(frame: NDArray[np.uint8], H: NDArray) -> NDArray[np.uint8]:
-    """cv2.warpPerspective of every plane by H (chroma by S H S⁻¹); black outside."""
+def warp_planes(
+    frame: NDArray[np.uint8], H: NDArray, full_range: bool = False
+) -> NDArray[np.uint8]:
+    """cv2.warpPerspective of every plane by H (chroma by S H S⁻¹); black outside (in
+    the frame's range)."""
     Hc = chroma_homography(H)
     out = np.empty_like(frame)
     # Each plane is warped straight into its place in the output: no joining copy.
     for plane, dst, M, fill in zip(
-        split(frame), split(out), (H, Hc, Hc), black(frame), strict=True
+        split(frame), split(out), (H, Hc, Hc), black(frame, full_range), strict=True
     ):
         size = (plane.shape[1], plane.shape[0])
         cv2.warpPerspective(plane, M, size, dst=dst, flags=cv2.INTER_LINEAR, borderValue=fill)
     return out
 
 
-def remap_planes(frame: NDArray, source: SourceMap) -> NDArray:
+def remap_planes(frame: NDArray, source: SourceMap, full_range: bool = False) -> NDArray:
     """Warp every plane by a map ``source`` (full-size output pixels → input pixels);
-    chroma sees the same map through the half-size coordinates."""
+    chroma sees the same map through the half-size coordinates; black outside."""
     y, u, v = split(frame)
     coarse = coarse_map(source, y.shape)
     dense = dense_map(coarse, y.shape)
     half = dense_map(half_knots(coarse), u.shape, MAP_STEP // 2)
-    fill = black(frame)
+    fill = black(frame, full_range)
     return join(
         remap_with(y, dense, fill[0]), remap_with(u, half, fill[1]), remap_with(v, half, fill[2])
     )

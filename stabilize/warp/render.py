@@ -59,13 +59,22 @@ def render(
     resize = resize_planes if planar else resize_image
     try:
         with FrameWriter(
-            target, size, fps, encoding, mux, pix_fmt_in=pix_fmt, container=container
+            target,
+            size,
+            fps,
+            encoding,
+            mux,
+            pix_fmt_in=pix_fmt,
+            container=container,
+            colour=info.colour,
         ) as writer:
             decoded = read_frames(path, info=info, pix_fmt=pix_fmt)
             frames = zip(range(len(planned.zoom)), decoded, strict=False)
             for batch in batches(frames, WARP_BATCH if settings.device == "cuda" else 1):
                 for frame, warped in zip(
-                    (f for _, f in batch), planned.warp_many(batch, settings.device), strict=True
+                    (f for _, f in batch),
+                    planned.warp_many(batch, settings.device, info.colour.full_range),
+                    strict=True,
                 ):
                     if settings.size:
                         frame, warped = resize(frame, (h, w)), resize(warped, (h, w))

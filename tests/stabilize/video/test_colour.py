@@ -1,0 +1,95 @@
+"""The source's colour description (range, matrix, primaries, transfer) is read and kept:
+a full-range clip comes out full range, its tones unchanged, its borders black."""
+
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numpy.typing import NDArray
+
+from stabilize import Settings, stabilize_video
+from stabilize.video import ffmpeg_exe, probe, read_frames
+from stabilize.video.colour import Colour, colour_of
+from stabilize.video.i420 import black
+
+BT709 = ("bt709",) * 3
+
+
+@pytest.mark.parametrize(
+    ("pix_fmt", "details", "expected"),
+    [
+        ("yuvj420p", "tv, bt709, progressive", Colour("pc", *BT709)),  # GoPro's: yuvj wins
+        ("yuv420p", "pc, bt709", Colour("pc", *BT709)),
+        (
+            "yuv420p10le",
+            "tv, bt2020nc/bt2020/smpte2084",
+            Colour("tv", "bt2020nc", "bt2020", "smpte2084"),
+        ),
+        ("yuvj444p", "pc, bt709/unknown/unknown", Colour("pc", "bt709")),
+        ("yuv420p", "tv, progressive", Colour("tv")),
+        ("yuv444p", "", Colour()),
+    ],
+)
+def test_the_description_ffmpeg_lists_is_read(pix_fmt, details, expected):
+    assert colour_of(pix_fmt, details) == expected
+
+
+def test_what_is_unknown_is_not_stated():
+    assert Colour("tv").ffmpeg_args() == ["-color_range", "tv"]
+    assert Colour().ffmpeg_args() == []
+
+
+def test_black_is_zero_luma_in_full_range():
+    frame = np.zeros((12, 8), np.uint8)
+    assert black(frame) == (16, 128, 128)
+    assert black(frame, full_range=True) == (0, 128, 128)
+    assert black(frame.astype(np.uint16), full_range=True) == (0, 512, 512)
+
+
+# A full-range BT.709 clip, as a phone or a GoPro writes one (as output options alone,
+# FFmpeg drops the primaries and transfer it converts to)
+FULL_RANGE = (
+    "scale=out_range=pc:out_color_matrix=bt709,format=yuvj420p,"
+    "setparams=range=pc:colorspace=bt709:color_primaries=bt709:color_trc=bt709"
+)
+
+
+def _full_range(source: list[str], out: Path) -> Path:
+    cmd = [ffmpeg_exe(), "-v", "error", "-y", *source, "-vf", FULL_RANGE]
+    subprocess.run([*cmd, "-c:v", "libx264", "-crf", "12", str(out)], check=True)
+    return out
+
+
+def _luma(path: Path) -> NDArray:
+    """The clip's luma samples (N, H, W), as stored."""
+    frames = read_frames(path, pix_fmt="yuv420p")
+    return np.array([frame[: frame.shape[0] * 2 // 3] for frame in frames])
+
+
+def test_a_full_range_clip_keeps_its_range_and_its_samples(tmp_path):
+    bars = ["-f", "lavfi", "-i", "smptehdbars=s=320x180:r=15:d=2"]  # still: an identity warp
+    source = _full_range(bars, tmp_path / "bars.mp4")
+    assert probe(source).colour == Colour("pc", *BT709)
+    out = tmp_path / "out.mp4"
+    stabilize_video(source, out, Settings())
+    assert probe(out).colour == Colour("pc", *BT709)  # tagged limited before: stretched
+    # stated only on the output side, FFmpeg squeezed the samples into limited range
+    difference = np.abs(_luma(out).astype(int) - _luma(source))
+    assert np.median(difference) <= 1 and np.percentile(difference, 99) <= 4
+
+
+def test_borders_are_black_in_full_range(shaky, tmp_path):
+    source = _full_range(["-i", str(shaky)], tmp_path / "full.mp4")
+    out = tmp_path / "out.mp4"
+    stabilize_video(source, out, Settings(crop="none"))  # the borders show
+    corners = _luma(out)[:, [0, 0, -1, -1], [0, -1, 0, -1]]
+    assert corners.min() <= 2  # limited range's black, 16, is a dark grey here
+
+
+def test_a_source_that_says_nothing_gets_the_encoders_defaults(shaky, tmp_path):
+    out = tmp_path / "out.mp4"
+    stabilize_video(shaky, out, Settings())
+    assert probe(out).colour.range in (None, "tv")
