@@ -33,6 +33,7 @@ TRANSFERS = frozenset(
     "bt709 gamma22 gamma28 smpte170m smpte240m linear log100 log316 iec61966-2-4 bt1361e "
     "iec61966-2-1 bt2020-10 bt2020-12 smpte2084 smpte428 arib-std-b67".split()
 )
+NAMES = MATRICES | PRIMARIES | TRANSFERS
 
 
 @dataclass(frozen=True)
@@ -82,7 +83,7 @@ def colour_of(pix_fmt: str, details: str) -> Colour:
     tokens = [t.strip() for t in details.split(",")]
     ranges = [t for t in tokens if t in ("tv", "pc")]
     rng = "pc" if pix_fmt.startswith("yuvj") else (ranges[0] if ranges else None)
-    named = [t for t in tokens if "/" in t or t in MATRICES | PRIMARIES | TRANSFERS]
+    named = [t for t in tokens if "/" in t or t in NAMES]
     if not named:
         return Colour(rng)
     parts = named[0].split("/")

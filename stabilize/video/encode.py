@@ -9,7 +9,7 @@ clip, whose audio, subtitles, chapters and metadata are kept:
 from __future__ import annotations
 
 import subprocess
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -103,7 +103,7 @@ class FrameWriter:
         colour: Colour | None = None,
     ) -> None:
         encoding, mux = encoding or Encoding(), mux or Mux()
-        tags = (colour or UNKNOWN).ffmpeg_args()
+        colour = colour or UNKNOWN
         h, w = size
         self.path = Path(path)
         self.shape, self.dtype = pipe_layout(pix_fmt_in, size)
@@ -112,13 +112,12 @@ class FrameWriter:
         # YUV samples are the source's own: stated on the pipe, they are not converted.
         # RGB ones have no range or matrix, but FFmpeg drops primaries and transfer that
         # the output alone states when it converts.
-        rgb = Colour(primaries=colour.primaries, transfer=colour.transfer) if colour else None
-        given = tags if pix_fmt_in.startswith("yuv") else (rgb or UNKNOWN).ffmpeg_args()
-        cmd += [*raw, *given, "-i", "pipe:"]
+        piped = colour if pix_fmt_in.startswith("yuv") else replace(colour, range=None, matrix=None)
+        cmd += [*raw, *piped.ffmpeg_args(), "-i", "pipe:"]
         for extra in mux.inputs:
             cmd += list(extra)
         cmd += ["-map", "0:v", *mux.args, *_delayed(mux.video_delay)]
-        cmd += [*output_args(path, encoding, container), *tags, str(path)]
+        cmd += [*output_args(path, encoding, container), *colour.ffmpeg_args(), str(path)]
         self._process = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
         widen_pipe(self._process.stdin)
 
