@@ -20,6 +20,7 @@ import os
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -181,7 +182,9 @@ def dates_rows(settings: Settings) -> bool:
 def _motion(src: Path, job: Job, settings: Settings, bar, tell) -> tuple:
     """(track, focal length, :func:`_rotations`): pass 1, with its notices."""
     bands = READOUT_BANDS if dates_rows(settings) else 0
-    keep = bands > 0 and job.log is None  # the vectors, measured again once rows are dated
+    # the flow vectors (about 5 KB a pair): the repair checks a jump against them, and
+    # they are measured again once a rolling shutter's rows are dated
+    keep = job.log is None
     estimating = bar("estimating", max(len(job.times) - 1, 0))
     track, focal = estimate_motion(
         src,
@@ -217,7 +220,9 @@ def _rotations(
             settings, job.log, track, job.info.height, job.lens, job.stamps
         )
     else:
-        R, reliable = repair_unreliable(track.rotations, track.support)
+        samples = track.samples
+        agreeing = None if samples is None else partial(samples.agreeing, focal=focal)
+        R, reliable = repair_unreliable(track.rotations, track.support, agreeing)
         rolling, summary = None, None
         from stabilize.shutter import readout_for, visual_rolling_shutter
 

@@ -16,8 +16,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rotation import RotationEstimate
+from stabilize.motion.residual import landing
 
 MIN_BAND_SUPPORT = 0.05  # a band with so few agreeing vectors says little about its time
+# px at the flow's size: a vector that lands this close to where a rotation puts its point
+# agrees with that rotation (the focal search's outlier cost starts at the same distance)
+AGREE_PX = 1.5
 
 
 @dataclass(frozen=True)
@@ -41,6 +45,14 @@ class Samples:
         """The pairs first..stop-1."""
         part = slice(first, stop)
         return replace(self, u=self.u[part], v=self.v[part], valid=self.valid[part])
+
+    def agreeing(self, pair: int, R: NDArray, focal: float) -> int:
+        """How many of pair ``pair``'s valid vectors land within ``AGREE_PX`` of where the
+        rotation R (3, 3) puts their points, at ``focal`` (px of the input frames)."""
+        f = focal * self.scale
+        lx, ly = landing(self.x, self.y, np.asarray(R, np.float64)[None], f)
+        miss = np.hypot(self.x + self.u[pair] - f * lx[0], self.y + self.v[pair] - f * ly[0])
+        return int(np.count_nonzero(self.valid[pair] & (miss < AGREE_PX)))
 
 
 @dataclass(frozen=True)

@@ -1,9 +1,14 @@
 """Repairing the frames too few flow vectors agreed on, and that jump."""
 
+from dataclasses import replace
+from functools import partial
+
 import numpy as np
 
 from rotation import so3
-from stabilize.motion.repair import repair_unreliable
+from stabilize.motion.repair import MIN_AGREEING, repair_unreliable
+from stabilize.motion.residual import landing
+from stabilize.motion.track import Samples
 
 
 def test_a_jump_few_vectors_voted_for_is_repaired_from_its_neighbours():
@@ -26,3 +31,65 @@ def test_a_low_support_frame_that_follows_a_fast_shake_is_kept():
     R, reliable = repair_unreliable(so3.exp_so3(rv), support)
     assert reliable.all()
     np.testing.assert_allclose(so3.log_so3(R), rv, atol=1e-12)
+
+
+F = 400.0  # px, the flow's focal length (scale 1)
+
+
+def grid_samples(rotations: np.ndarray, subject: np.ndarray | None = None) -> Samples:
+    """Samples of a 24×24 grid whose static points move as ``rotations`` (n, 3, 3) turn
+    them; where ``subject`` (n, 3, 3) is given, the grid's left 40% moves by it instead."""
+    gx, gy = np.meshgrid(np.linspace(-300, 300, 24), np.linspace(-170, 170, 24))
+    x, y = gx.ravel(), gy.ravel()
+    lx, ly = landing(x, y, rotations, F)
+    u, v = F * lx - x, F * ly - y
+    if subject is not None:
+        sx, sy = landing(x, y, subject, F)
+        left = x < np.quantile(x, 0.4)
+        u[:, left], v[:, left] = (F * sx - x)[:, left], (F * sy - y)[:, left]
+    valid = np.ones(u.shape, bool)
+    return Samples(u.astype(np.float32), v.astype(np.float32), valid, x, y, gy.ravel(), 340)
+
+
+def spiked(spike_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation vectors of a steady pan with pair 4 turned ``spike_deg`` about y, and
+    supports with pair 4's low."""
+    rv = np.tile([0.002, 0.0, 0.0], (9, 1))
+    rv[4] = [0.0, np.radians(spike_deg), 0.0]
+    support = np.full(9, 0.3)
+    support[4] = 0.02
+    return rv, support
+
+
+def test_a_jolt_the_flow_follows_is_kept():
+    rv, support = spiked(3.0)
+    R = so3.exp_so3(rv)
+    samples = grid_samples(R)  # the whole scene turned with the jolt
+    kept, reliable = repair_unreliable(R, support, partial(samples.agreeing, focal=F))
+    assert reliable.all()
+    np.testing.assert_allclose(so3.log_so3(kept), rv, atol=1e-12)
+    # without the flow, the same jump is repaired
+    _, blind = repair_unreliable(R, support)
+    assert not blind[4]
+
+
+def test_a_subject_that_won_the_vote_is_repaired_though_the_flow_is_at_hand():
+    rv, support = spiked(3.0)
+    steady = rv.copy()
+    steady[4] = rv[3]
+    # the scene turned with its neighbours; a subject over 40% of the frame swept 3°
+    samples = grid_samples(so3.exp_so3(steady), subject=so3.exp_so3(rv))
+    R, reliable = repair_unreliable(so3.exp_so3(rv), support, partial(samples.agreeing, focal=F))
+    assert not reliable[4]
+    np.testing.assert_allclose(so3.log_so3(R[4]), rv[3], atol=1e-12)
+
+
+def test_a_jump_too_few_vectors_follow_is_repaired():
+    rv, support = spiked(3.0)
+    R = so3.exp_so3(rv)
+    samples = grid_samples(R)
+    few = np.zeros_like(samples.valid)
+    few[:, : MIN_AGREEING - 1] = True  # the rest of the frame blurred or covered
+    sparse = replace(samples, valid=few)
+    _, reliable = repair_unreliable(R, support, partial(sparse.agreeing, focal=F))
+    assert not reliable[4]
