@@ -81,12 +81,14 @@ class Registrar:
     def fit(self, matched: tuple[NDArray, NDArray] | None, width: int) -> NDArray[np.float64]:
         """H with dst ~ H src of matched points (src, dst) in frames ``width`` px wide;
         identity, counted as a failure, if it cannot be found, or if its inliers spread
-        less than ``MIN_SPREAD`` of the width across their narrowest direction (a strip,
-        which leaves the rest undetermined)."""
+        less than ``MIN_SPREAD`` of the width across their narrowest direction in either
+        frame (a strip, which leaves the rest undetermined)."""
         if matched is not None:
             H, mask = cv2.findHomography(*matched, cv2.USAC_MAGSAC, 1.5)
             if H is not None and mask.sum() >= MIN_MATCHES:
-                if principal_spread(matched[0][mask.ravel() > 0])[0] >= MIN_SPREAD * width:
+                kept = mask.ravel() > 0
+                narrowest = min(principal_spread(pts[kept])[0] for pts in matched)
+                if narrowest >= MIN_SPREAD * width:
                     return H / H[2, 2]
         self.failures += 1
         return np.eye(3)

@@ -63,11 +63,14 @@ def principal_spread(points: NDArray) -> NDArray[np.float64]:
 def similarity_motion(src: NDArray, dst: NDArray, width: int) -> NDArray[np.float64] | None:
     """(dx, dy, dθ, d ln s) of the similarity taking matched points ``src`` to ``dst``
     (RANSAC) in a frame ``width`` px wide, or None where too few agree or they bunch
-    together (their RMS distance from their centroid under ``MIN_SPREAD`` of the width)."""
+    together in either frame (their RMS distance from their centroid under ``MIN_SPREAD``
+    of the width: features of one frame matched to one point of the other fit a
+    similarity that sends everything there)."""
     M, inliers = cv2.estimateAffinePartial2D(src, dst, method=cv2.RANSAC, ransacReprojThreshold=1.5)
     if M is None or inliers.sum() < MIN_MATCHES:
         return None
-    overall = float(np.linalg.norm(principal_spread(src[inliers.ravel() > 0])))
+    kept = inliers.ravel() > 0
+    overall = min(float(np.linalg.norm(principal_spread(pts[kept]))) for pts in (src, dst))
     scale = float(np.hypot(M[0, 0], M[1, 0]))
     if overall < MIN_SPREAD * width or not scale > 0:  # (scale 0: all sent to one place)
         return None

@@ -69,6 +69,17 @@ def test_points_bunched_together_fix_no_similarity():
     assert similarity_motion(cluster, moved, WIDTH) is None
 
 
+def test_features_matched_to_one_point_fix_no_similarity():
+    # spread features all matched to one feature of the next frame (cockatoo's lens
+    # covered, read upside down): the fit sent everything there, a zoom of 1/1000 that
+    # alone read 261 px of shake for the clip
+    points = np.random.default_rng(4).uniform([0, 0], [WIDTH, 300], (40, 2)).astype(np.float32)
+    one = np.tile(np.float32([[200.0, 150.0]]), (40, 1))
+    one += np.random.default_rng(5).normal(0, 0.2, one.shape).astype(np.float32)
+    assert similarity_motion(points, one, WIDTH) is None
+    assert similarity_motion(one, points, WIDTH) is None
+
+
 def test_a_long_strip_of_points_fixes_a_similarity():
     # along a strip the roll and the scale show; only a homography needs more
     strip = np.random.default_rng(3).uniform([0, 100], [WIDTH, 106], (60, 2)).astype(np.float32)
