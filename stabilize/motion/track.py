@@ -33,18 +33,29 @@ class Samples:
 
     u: NDArray[np.float32]  # (N-1, M)
     v: NDArray[np.float32]
-    valid: NDArray[np.bool_]
+    valid: NDArray[np.bool_]  # finite: the bands and the focal length's search use these
     # the grid: (M,) points about the principal point and their rows, flow px
     x: NDArray[np.float64] | None = None
     y: NDArray[np.float64] | None = None
     rows: NDArray[np.float64] | None = None
     height: int = 0  # the flow field's, px
     scale: float = 1.0  # flow px per input px (the estimator's focal is f·scale)
+    # the valid vectors where the first frame had the texture to measure (flow.texture): these vote
+    # for the frame's rotation and measure what it leaves (None: all the valid ones)
+    measured: NDArray[np.bool_] | None = None
 
     def pairs(self, first: int, stop: int) -> Samples:
         """The pairs first..stop-1."""
         part = slice(first, stop)
-        return replace(self, u=self.u[part], v=self.v[part], valid=self.valid[part])
+        measured = None if self.measured is None else self.measured[part]
+        return replace(
+            self, u=self.u[part], v=self.v[part], valid=self.valid[part], measured=measured
+        )
+
+    @property
+    def voting(self) -> NDArray[np.bool_]:
+        """The vectors that vote for a pair's rotation and measure what it leaves."""
+        return self.valid if self.measured is None else self.valid & self.measured
 
     def agreeing(self, pair: int, R: NDArray, focal: float) -> int:
         """How many of pair ``pair``'s valid vectors land within ``AGREE_PX`` of where the
@@ -52,7 +63,7 @@ class Samples:
         f = focal * self.scale
         lx, ly = landing(self.x, self.y, np.asarray(R, np.float64)[None], f)
         miss = np.hypot(self.x + self.u[pair] - f * lx[0], self.y + self.v[pair] - f * ly[0])
-        return int(np.count_nonzero(self.valid[pair] & (miss < AGREE_PX)))
+        return int(np.count_nonzero(self.voting[pair] & (miss < AGREE_PX)))
 
 
 @dataclass(frozen=True)

@@ -46,5 +46,5 @@ def rectified_residual(
         after = (end.swapaxes(-1, -2) @ seen[..., None])[..., 0]  # D_{k+1}(y')ᵀ p'
         turned = (R[part][:, None] @ before[..., None])[..., 0]
         (ax, ay), (tx, ty) = normalised(after), normalised(turned)
-        out.append(background_similarity(x, y, ax - tx, ay - ty, samples.valid[part], f))
+        out.append(background_similarity(x, y, ax - tx, ay - ty, samples.voting[part], f))
     return np.concatenate(out) if out else np.zeros((0, 4))

@@ -1,0 +1,53 @@
+"""stabilize.motion.estimate: pass 1 on a rendered clip whose rotations are known."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import stabilize.motion.estimate as estimate
+from rotation import so3
+from stabilize import Settings
+from stabilize.motion.files import read_rotations
+from stabilize.video import FrameWriter, probe, read_frames
+from tests.stabilize.helpers import SAMPLE
+
+PANEL = 0.55  # the panel covers the rows below this share of the height
+
+
+@pytest.fixture(scope="module")
+def dashboard_clip(tmp_path_factory) -> Path:
+    """The rendered sample with its lower 45% covered by a flat, static grey panel, as a
+    car's dashboard covers a phone's view: the flow there can only be filled in."""
+    clip = tmp_path_factory.mktemp("dashboard") / "clip.mp4"
+    info = probe(SAMPLE / "clip.mp4")
+    with FrameWriter(clip, info.size, info.fps) as writer:
+        for frame in read_frames(SAMPLE / "clip.mp4", info=info):
+            covered = frame.copy()
+            covered[int(PANEL * info.size[0]) :] = 128
+            writer.write(covered)
+    return clip
+
+
+def test_only_vectors_where_the_frame_has_texture_vote(dashboard_clip, monkeypatch):
+    info = probe(dashboard_clip)
+    truth = read_rotations(SAMPLE / "truth.csv")
+    R_true = so3.exp_so3(np.array([truth[k] for k in range(89)]))
+    focal = float(json.loads((SAMPLE / "truth.json").read_text())["K"][0][0])
+    track = estimate.estimate_rotations(
+        dashboard_clip, info, Settings(focal=focal), keep_samples=True
+    )
+    samples = track.samples
+    inside = samples.rows > PANEL * samples.height + 4  # clear of the panel's edge
+    assert samples.valid[:, inside].all()  # finite: the bands still see them
+    assert not samples.voting[:, inside].any() and samples.voting[:, ~inside].mean() > 0.6
+    err = so3.angular_error_deg(track.rotations, R_true).mean()
+    # every vector voting: the panel's filled-in flow pulls towards no motion
+    monkeypatch.setattr(
+        estimate, "textured", lambda frame, rows, cols: np.ones(rows.size * cols.size, bool)
+    )
+    every = estimate.estimate_rotations(dashboard_clip, info, Settings(focal=focal))
+    err_every = so3.angular_error_deg(every.rotations, R_true).mean()
+    # measured: 0.028° against 0.078° (uncovered, the sample reads 0.021° either way)
+    assert err < 0.04 and err_every > 2 * err, (err, err_every)
