@@ -40,8 +40,8 @@ class Samples:
     rows: NDArray[np.float64] | None = None
     height: int = 0  # the flow field's, px
     scale: float = 1.0  # flow px per input px (the estimator's focal is f·scale)
-    # the valid vectors where the first frame had the texture to measure (flow.texture): these vote
-    # for the frame's rotation and measure what it leaves (None: all the valid ones)
+    # the valid vectors where the first frame had the texture to measure (flow.texture):
+    # these vote for the frame's rotation and measure what it leaves (None: every valid one)
     measured: NDArray[np.bool_] | None = None
 
     def pairs(self, first: int, stop: int) -> Samples:
@@ -55,7 +55,7 @@ class Samples:
     @property
     def voting(self) -> NDArray[np.bool_]:
         """The vectors that vote for a pair's rotation and measure what it leaves."""
-        return self.valid if self.measured is None else self.valid & self.measured
+        return self.valid if self.measured is None else self.measured
 
     def agreeing(self, pair: int, R: NDArray, focal: float) -> int:
         """How many of pair ``pair``'s valid vectors land within ``AGREE_PX`` of where the
