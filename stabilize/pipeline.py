@@ -221,8 +221,11 @@ def _rotations(
         )
     else:
         samples = track.samples
-        agreeing = None if samples is None else partial(samples.agreeing, focal=focal)
-        R, reliable = repair_unreliable(track.rotations, track.support, agreeing)
+        agreeing = refined = None
+        if samples is not None:
+            agreeing = partial(samples.agreeing, focal=focal)
+            refined = partial(samples.refined, focal=focal)
+        R, reliable = repair_unreliable(track.rotations, track.support, agreeing, refined)
         rolling, summary = None, None
         from stabilize.shutter import readout_for, visual_rolling_shutter
 

@@ -16,12 +16,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rotation import RotationEstimate
+from rotation.refine import refine
 from stabilize.motion.residual import landing
 
 MIN_BAND_SUPPORT = 0.05  # a band with so few agreeing vectors says little about its time
 # px at the flow's size: a vector that lands this close to where a rotation puts its point
 # agrees with that rotation (the focal search's outlier cost starts at the same distance)
 AGREE_PX = 1.5
+# px at the flow's size: a rotation refined from a guess starts from the vectors that land
+# this close to where the guess puts them (twice the agreement's distance: a hand's shake
+# moves the static scene 1–2 px a frame off its neighbours' mean on cockatoo)
+REFINE_FROM_PX = 2 * AGREE_PX
 
 
 @dataclass(frozen=True)
@@ -64,6 +69,17 @@ class Samples:
         lx, ly = landing(self.x, self.y, np.asarray(R, np.float64)[None], f)
         miss = np.hypot(self.x + self.u[pair] - f * lx[0], self.y + self.v[pair] - f * ly[0])
         return int(np.count_nonzero(self.voting[pair] & (miss < AGREE_PX)))
+
+    def refined(self, pair: int, R: NDArray, focal: float) -> NDArray[np.float64]:
+        """The rotation (3, 3) pair ``pair``'s voting vectors settle on from the guess R
+        (:func:`rotation.refine.refine`, starting from those within ``REFINE_FROM_PX``
+        of where R puts their points), at ``focal`` (px of the input frames): the motion
+        of whatever moves nearest the guess."""
+        f = focal * self.scale
+        qx = self.x + self.u[pair].astype(np.float64)
+        qy = self.y + self.v[pair].astype(np.float64)
+        guess = np.asarray(R, np.float64)
+        return refine(self.x, self.y, qx, qy, f, guess, self.voting[pair], REFINE_FROM_PX)
 
 
 @dataclass(frozen=True)

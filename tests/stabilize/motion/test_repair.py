@@ -93,3 +93,31 @@ def test_a_jump_too_few_vectors_follow_is_repaired():
     sparse = replace(samples, valid=few)
     _, reliable = repair_unreliable(R, support, partial(sparse.agreeing, focal=F))
     assert not reliable[4]
+
+
+def test_the_repair_keeps_the_shake_the_scene_shows_in_a_frame_a_subject_won():
+    # the scene shakes 0.3° off its neighbours in pair 4, and a subject over 40% of the
+    # frame swept 3°, winning the vote: the repair is the scene's own rotation, shake
+    # and all, not the neighbours' mean
+    rv, support = spiked(3.0)
+    scene = rv.copy()
+    scene[4] = rv[3] + [0.0, np.radians(0.3), 0.0]
+    samples = grid_samples(so3.exp_so3(scene), subject=so3.exp_so3(rv))
+    agreeing, refined = partial(samples.agreeing, focal=F), partial(samples.refined, focal=F)
+    R, reliable = repair_unreliable(so3.exp_so3(rv), support, agreeing, refined)
+    assert not reliable[4]
+    assert np.degrees(np.linalg.norm(so3.log_so3(R[4:5])[0] - scene[4])) < 0.01
+    R_mean, _ = repair_unreliable(so3.exp_so3(rv), support, agreeing)
+    assert np.degrees(np.linalg.norm(so3.log_so3(R_mean[4:5])[0] - scene[4])) > 0.25
+
+
+def test_a_jolt_the_flow_settles_on_from_the_neighbours_is_kept():
+    # a pan that speeds up 0.2° a frame at the clip's end, with little support there
+    rv = np.c_[np.zeros(9), np.radians(np.r_[np.full(6, 0.6), 0.8, 1.0, 1.2]), np.zeros(9)]
+    support = np.r_[np.full(6, 0.6), 0.15, 0.15, 0.15]
+    R = so3.exp_so3(rv)
+    samples = grid_samples(R)
+    agreeing, refined = partial(samples.agreeing, focal=F), partial(samples.refined, focal=F)
+    kept, reliable = repair_unreliable(R, support, agreeing, refined)
+    assert reliable.all()
+    np.testing.assert_allclose(so3.log_so3(kept), rv, atol=1e-12)
