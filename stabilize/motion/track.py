@@ -24,8 +24,10 @@ MIN_BAND_SUPPORT = 0.05  # a band with so few agreeing vectors says little about
 # agrees with that rotation (the focal search's outlier cost starts at the same distance)
 AGREE_PX = 1.5
 # px at the flow's size: a rotation refined from a guess starts from the vectors that land
-# this close to where the guess puts them (twice the agreement's distance: a hand's shake
-# moves the static scene 1–2 px a frame off its neighbours' mean on cockatoo)
+# this close to where the guess puts them. Twice the agreement's distance: a hand's shake
+# moved cockatoo's static scene 2–3 px a frame off its neighbours' mean (its pair 59,
+# repaired from 2 px, stayed 3 px off what the window behind the bird moved; from 3 or
+# 4.5 px, 0.9 and 1.0 px off)
 REFINE_FROM_PX = 2 * AGREE_PX
 
 
