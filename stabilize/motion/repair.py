@@ -86,12 +86,14 @@ def repair_unreliable(
             continue
         repair = mean
         if agreeing is not None:
-            agree = agreeing(k, so3.exp_so3(mean))
+            guess = so3.exp_so3(mean)
+            agree = agreeing(k, guess)
             if refined is not None:
-                settled = so3.log_so3(refined(k, so3.exp_so3(mean))[None])[0]
+                R_settled = refined(k, guess)
+                settled = so3.log_so3(R_settled[None])[0]
                 if np.linalg.norm(settled - rotvecs[k]) < np.linalg.norm(settled - mean):
                     continue  # from the neighbours' motion the flow settles on the jump
-                agree_settled = agreeing(k, so3.exp_so3(settled))
+                agree_settled = agreeing(k, R_settled)
                 if agree_settled > agree:
                     repair, agree = settled, agree_settled
             follows = agreeing(k, R[k])

@@ -65,7 +65,7 @@ class Samples:
         return self.valid if self.measured is None else self.measured
 
     def agreeing(self, pair: int, R: NDArray, focal: float) -> int:
-        """How many of pair ``pair``'s valid vectors land within ``AGREE_PX`` of where the
+        """How many of pair ``pair``'s voting vectors land within ``AGREE_PX`` of where the
         rotation R (3, 3) puts their points, at ``focal`` (px of the input frames)."""
         f = focal * self.scale
         lx, ly = landing(self.x, self.y, np.asarray(R, np.float64)[None], f)
