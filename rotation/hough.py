@@ -45,6 +45,7 @@ from rotation.models import lh_line, perspective_curve
 from rotation.refine import refine, rodrigues, rotate_ray
 from rotation.result import RotationEstimate
 from rotation.sampling import check_flows, sample_flows, sample_grid
+from rotation.so3 import log_so3
 from rotation.voting import (
     BEST,
     BEST_COUNT,
@@ -135,7 +136,7 @@ class HoughEstimator:
             R, count, inliers = estimate_field(
                 *self._field_args(u, v, valid), self._acc, self._touched
             )
-        return self._result(R, count, inliers, valid)
+        return self._result(R, log_so3(R), count, inliers, valid)
 
     def estimate_many(self, flows: NDArray) -> list[RotationEstimate]:
         """Rotations of a stack (N, H, W, 2), in parallel over the available cores.
@@ -174,17 +175,24 @@ class HoughEstimator:
 
         with ThreadPoolExecutor(threads) as pool:
             list(pool.map(run, range(chunks)))
-        return [self._result(*item) for item in zip(Rs, counts, inliers, valid, strict=True)]
+        # the rotation vectors in one call: one per estimate cost 0.15 ms each, 0.6 s of
+        # a 1080p 10 s clip's pass 1 (12 bands a pair)
+        rotvecs = log_so3(Rs)
+        return [
+            self._result(*item) for item in zip(Rs, rotvecs, counts, inliers, valid, strict=True)
+        ]
 
     def _field_args(self, u: NDArray, v: NDArray, valid: NDArray) -> tuple:
         """The kernels' leading arguments: samples, flow, focal length, search, model."""
         x, y = self.grid.x, self.grid.y
         return x, y, u, v, valid, self.focal, self.levels, self._model_code, self.refine
 
-    def _result(self, R: NDArray, count: int, inliers: NDArray, valid: NDArray) -> RotationEstimate:
+    def _result(
+        self, R: NDArray, rotvec: NDArray, count: int, inliers: NDArray, valid: NDArray
+    ) -> RotationEstimate:
         n_valid = int(valid.sum())
         support = count / n_valid if n_valid >= MIN_VECTORS else 0.0
-        return RotationEstimate.from_matrix(R, support, inliers.reshape(self.grid.shape))
+        return RotationEstimate(R, rotvec, float(support), inliers.reshape(self.grid.shape))
 
 
 def estimate(flow: NDArray, focal: float, **options) -> RotationEstimate:

@@ -31,7 +31,7 @@ import flow
 from rotation import HoughEstimator, so3
 from rotation.camera import focal_from_fov, fov_from_focal
 from rotation.focal import estimate_focal
-from stabilize.motion.estimate import estimate_again, estimate_rotations
+from stabilize.motion.estimate import estimate_again, estimate_rotations, with_bands
 from stabilize.motion.track import VisualTrack
 from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
@@ -144,7 +144,7 @@ def estimate_motion(
         at_start,
         progress,
         times,
-        bands=bands,
+        bands=0 if auto else bands,  # with the focal length settled (with_bands)
         lens=lens,
         keep_samples=auto or keep_samples,
     )
@@ -152,15 +152,15 @@ def estimate_motion(
         return track, choice
     kept = (lambda t: t) if keep_samples else (lambda t: replace(t, samples=None))
     ws = flow.working_size(info.size)
-    start = HoughEstimator(ws.size, choice.px * ws.scale[0])
+    start = HoughEstimator(ws.size, choice.px * ws.scale[0], max_deg=settings.max_deg)
     found = focal_from_track(track, start, info.width * ws.scale[0])
     if found is None:
         note = f"the clip's motion does not pin the focal length down: {choice.source} kept"
-        return kept(track), replace(choice, note=note)
+        return kept(with_bands(start, track, bands)), replace(choice, note=note)
     px = found / ws.scale[0]
     meta = choice.metadata_px
     if meta and abs(px / meta - 1) <= DISAGREES:  # agreed: the lens's own figure is finer
-        return kept(track), replace(choice, estimated_px=px)
+        return kept(with_bands(start, track, bands)), replace(choice, estimated_px=px)
     note = f"{100 * (px / meta - 1):+.0f}% off the metadata's (a digital zoom?)" if meta else ""
     estimator = HoughEstimator(ws.size, found, max_deg=settings.max_deg)
     again = estimate_again(estimator, track, bands)
