@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import flow
 import stabilize.motion.estimate as estimate
 from rotation import so3
 from stabilize import Settings
@@ -51,3 +52,27 @@ def test_only_vectors_where_the_frame_has_texture_vote(dashboard_clip, monkeypat
     err_every = so3.angular_error_deg(every.rotations, R_true).mean()
     # measured: 0.028° against 0.078° (uncovered, the sample reads 0.021° either way)
     assert err < 0.04 and err_every > 2 * err, (err, err_every)
+
+
+def test_bands_voted_from_the_kept_samples_are_those_of_pass_1():
+    """with_bands, which votes the bands once the focal length is settled, gives what
+    pass 1 gives when it votes them beside the whole frame (and the overlapped votes
+    keep the pairs in order)."""
+    clip = SAMPLE / "clip.mp4"
+    info = probe(clip)
+    settings = Settings(fov=70.0)
+    inline = estimate.estimate_rotations(clip, info, settings, bands=6, keep_samples=True)
+    whole = estimate.estimate_rotations(clip, info, settings, keep_samples=True)
+    assert whole.bands is None
+    np.testing.assert_array_equal(whole.rotations, inline.rotations)
+    np.testing.assert_array_equal(whole.residual, inline.residual)
+    ws = flow.working_size(info.size)
+    focal = settings.focal_px(info.width) * ws.scale[0]
+    estimator = estimate.HoughEstimator(ws.size, focal, max_deg=settings.max_deg)
+    later = estimate.with_bands(estimator, whole, 6)
+    np.testing.assert_allclose(later.bands, inline.bands, atol=1e-12)
+    np.testing.assert_allclose(later.band_support, inline.band_support, atol=1e-12)
+    np.testing.assert_allclose(later.band_rows, inline.band_rows, atol=1e-12)
+    assert not np.array_equal(inline.bands[0], inline.rotations)  # the bands are their own
+    edges = np.linspace(0.0, 1.0, 7)[:, None]  # each band's vectors lie in it
+    assert ((later.band_rows >= edges[:-1] - 0.02) & (later.band_rows <= edges[1:])).all()
