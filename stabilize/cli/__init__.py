@@ -24,6 +24,7 @@ __all__ = ["COMMANDS", "app", "batch", "compare", "evaluate", "main", "rotations
 
 TOP_LEVEL = ("--help", "-h", "--version")  # what the app itself answers
 DEBUG = "STABILIZE_DEBUG"  # set: an internal error ends with its traceback
+INTERRUPTED = 130  # exit status after Ctrl-C (128 + SIGINT, as shells report it)
 
 
 def main() -> None:
@@ -44,9 +45,8 @@ def main() -> None:
         if message:  # (no arguments at all: the help was shown, and that is all)
             typer.echo(f"error: {message}", err=True)
         status = getattr(err, "exit_code", BAD_INPUT)
-    except KeyboardInterrupt:
-        typer.echo("error: interrupted; nothing was written under the output's name", err=True)
-        status = 130
+    except KeyboardInterrupt:  # outside a command (typer answers those itself, below)
+        status = INTERRUPTED
     except Exception as err:  # a fault of ours, not of the input: one line, not a traceback
         if os.environ.get(DEBUG):
             raise
@@ -57,6 +57,8 @@ def main() -> None:
             err=True,
         )
         status = FAILED
+    if status == INTERRUPTED:  # typer turns Ctrl-C within a command into this, silently
+        typer.echo("error: interrupted; no output was left half-written under its name", err=True)
     sys.exit(status or 0)
 
 

@@ -58,3 +58,15 @@ def test_a_bad_input_with_a_long_message_is_one_line_and_status_2(monkeypatch, t
         main()
     assert done.value.code == 2
     assert capsys.readouterr().err.strip() == "error: first line second line"
+
+
+def test_ctrl_c_is_one_line_and_status_130(monkeypatch, tmp_path, capsys):
+    # typer turns a KeyboardInterrupt within a command into exit status 130 and prints
+    # nothing; the user still gets the line
+    _, out = stabilising_fails(monkeypatch, tmp_path, KeyboardInterrupt())
+    with pytest.raises(SystemExit) as done:
+        main()
+    assert done.value.code == 130
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: interrupted"), err
+    assert not Path(out).exists()
