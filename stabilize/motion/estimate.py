@@ -147,7 +147,7 @@ def with_bands(estimator: HoughEstimator, track: VisualTrack, bands: int) -> Vis
     if not bands:
         return track
     samples = track.samples
-    masks = band_masks(estimator, estimator.size[0], bands)[1:]
+    masks = band_masks(estimator, estimator.size[0], bands)
     found: list[list[tuple]] = [[] for _ in masks]
     for part in _chunks(len(samples.u)):
         u, v, valid = samples.u[part], samples.v[part], samples.valid[part]
@@ -203,13 +203,12 @@ def _noting_texture(
 
 
 def band_masks(estimator: HoughEstimator, height: int, bands: int) -> list[NDArray]:
-    """Which sample vectors vote for the whole frame (all of them), then for each of
-    ``bands`` horizontal bands (those whose row lies in it)."""
+    """Which sample vectors vote for each of ``bands`` horizontal bands (those whose
+    row lies in it); every vector votes for the whole frame."""
     grid = estimator.grid
     rows = np.repeat(grid.rows, len(grid.cols))
     edges = np.linspace(0, height, bands + 1).round().astype(int)
-    masks = [np.ones(len(rows), bool)]
-    return masks + [(rows >= edges[b - 1]) & (rows < edges[b]) for b in range(1, bands + 1)]
+    return [(rows >= edges[b - 1]) & (rows < edges[b]) for b in range(1, bands + 1)]
 
 
 def _voted(voting: Future, progress: Progress) -> NDArray:
@@ -242,12 +241,13 @@ def _vote(
     found: list[list[tuple]],
 ) -> NDArray:
     """(R, support, mean row) of each pair into ``found``: the whole frame from the
-    ``measured`` vectors, then each band from its ``valid`` ones; returns the similarity
-    (n, 4) each whole-frame rotation leaves on the measured vectors."""
+    ``measured`` vectors, then each band (its mask in ``masks``) from its ``valid``
+    ones; returns the similarity (n, 4) each whole-frame rotation leaves on the measured
+    vectors."""
     grid = estimator.grid
     estimates = estimator.estimate_samples(u, v, measured)
     _note(estimator, estimates, found[0])
-    _vote_bands(estimator, u, v, valid, masks[1:], found[1:])
+    _vote_bands(estimator, u, v, valid, masks, found[1:])
     R = np.array([est.matrix for est in estimates])
     return residual_motion(grid.x, grid.y, u, v, measured, R, estimator.focal)
 
