@@ -38,7 +38,7 @@ from rotation import HoughEstimator
 from rotation.camera import scale_intrinsics
 from rotation.sampling import SampleGrid
 from stabilize.motion.residual import residual_motion
-from stabilize.motion.track import Samples, VisualTrack, mean_row
+from stabilize.motion.track import Samples, VisualTrack, mean_rows
 from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoError, VideoInfo, frame_times, read_frames
@@ -245,10 +245,10 @@ def _vote(
     ones; returns the similarity (n, 4) each whole-frame rotation leaves on the measured
     vectors."""
     grid = estimator.grid
-    estimates = estimator.estimate_samples(u, v, measured)
-    _note(estimator, estimates, found[0])
-    _vote_bands(estimator, u, v, valid, masks, found[1:])
-    R = np.array([est.matrix for est in estimates])
+    estimates = _estimated(estimator, u, v, [measured, *(valid & mask for mask in masks)])
+    for into, part in zip(found, estimates, strict=True):
+        _note(estimator, part, into)
+    R = np.array([est.matrix for est in estimates[0]])
     return residual_motion(grid.x, grid.y, u, v, measured, R, estimator.focal)
 
 
@@ -261,11 +261,29 @@ def _vote_bands(
     found: list[list[tuple]],
 ) -> None:
     """(R, support, mean row) of each pair's bands (their ``masks``) into ``found``."""
-    for mask, band in zip(masks, found, strict=True):
-        _note(estimator, estimator.estimate_samples(u, v, valid & mask), band)
+    estimates = _estimated(estimator, u, v, [valid & mask for mask in masks])
+    for into, part in zip(found, estimates, strict=True):
+        _note(estimator, part, into)
+
+
+def _estimated(
+    estimator: HoughEstimator, u: NDArray, v: NDArray, votes: list[NDArray]
+) -> list[list]:
+    """The n pairs' rotations (u, v (n, M)) from each of ``votes``' sets of vectors
+    (n, M), in one call: one vote per band and chunk spent 30% of the bands' time
+    starting threads and waiting on the slowest (1080p, 10 s: 0.42 s, 0.30 s so)."""
+    n = len(u)
+    times = len(votes)
+    estimates = estimator.estimate_samples(
+        np.tile(u, (times, 1)), np.tile(v, (times, 1)), np.concatenate(votes)
+    )
+    return [estimates[k * n : (k + 1) * n] for k in range(times)]
 
 
 def _note(estimator: HoughEstimator, estimates: list, into: list[tuple]) -> None:
     """Each estimate's (R, support, mean row) appended to ``into``."""
-    rows, height = estimator.grid.rows, estimator.size[0]
-    into.extend((est.matrix, est.support, mean_row(est, rows, height)) for est in estimates)
+    if not estimates:
+        return
+    inliers = np.stack([est.inliers for est in estimates])
+    rows = mean_rows(inliers, estimator.grid.rows, estimator.size[0])
+    into.extend((est.matrix, est.support, row) for est, row in zip(estimates, rows, strict=True))

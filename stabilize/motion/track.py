@@ -15,7 +15,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from rotation import RotationEstimate
 from rotation.refine import refine
 from stabilize.motion.residual import landing
 
@@ -121,9 +120,12 @@ class VisualTrack:
         )
 
 
-def mean_row(estimate: RotationEstimate, sample_rows: NDArray, height: int) -> float:
-    """Mean height (0 top .. 1 bottom) of the flow vectors that agreed with an estimate."""
-    per_row = estimate.inliers.sum(axis=1)
-    if per_row.sum() == 0:
-        return 0.5
-    return float(np.average(sample_rows + 0.5, weights=per_row) / height)
+def mean_rows(inliers: NDArray[np.bool_], sample_rows: NDArray, height: int) -> NDArray:
+    """Mean height (0 top .. 1 bottom) of the flow vectors that agreed with each of a
+    stack of estimates, from their inlier masks (n, rows, cols) on the sample grid's
+    rows ``sample_rows``; 0.5 where none agreed."""
+    per_row = inliers.sum(axis=2)
+    total = per_row.sum(axis=1)
+    weighted = (per_row * (np.asarray(sample_rows) + 0.5)).sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(total > 0, weighted / total / height, 0.5)

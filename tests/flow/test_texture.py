@@ -3,7 +3,7 @@
 import cv2
 import numpy as np
 
-from flow.texture import MIN_TEXTURE, min_eigenvalue, textured
+from flow.texture import MIN_TEXTURE, min_eigenvalue, min_eigenvalue_at, textured
 
 ROWS = COLS = np.arange(8, 57, 8)
 
@@ -41,3 +41,12 @@ def test_the_measure_is_the_structure_tensors_smaller_eigenvalue_in_grey_levels(
     a, b, c = (cv2.blur(p, (7, 7)) for p in (gx * gx, gx * gy, gy * gy))
     expected = 0.5 * (a + c - np.sqrt((a - c) ** 2 + 4 * b * b))
     assert np.allclose(min_eigenvalue(grey), expected, rtol=1e-4, atol=1e-4)
+
+
+def test_the_measure_at_points_is_the_whole_maps_there():
+    rng = np.random.default_rng(3)
+    grey = cv2.GaussianBlur(rng.integers(0, 256, (45, 70)).astype(np.uint8), (3, 3), 0.8)
+    rows, cols = np.array([0, 1, 2, 17, 42, 43, 44]), np.array([0, 2, 3, 35, 66, 69])
+    whole = min_eigenvalue(grey)
+    at = min_eigenvalue_at(grey, rows, cols)  # the border too, reflected as OpenCV's
+    assert np.allclose(at, whole[np.ix_(rows, cols)], rtol=1e-6, atol=1e-9)
