@@ -65,6 +65,6 @@ def test_a_curve_flat_on_one_side_pins_nothing_down(monkeypatch):
     zeros = np.zeros((40, len(est.grid.x)))
     args = (est.grid.x, est.grid.y, zeros, zeros, zeros == 0, np.zeros((40, 3)), start, BOUNDS)
     for curve, pinned in ((floor, False), (dip, True), (narrow, True)):
-        costs = iter([curve, np.linspace(1.1, 1.1, 9) - 0.1 * np.hanning(9)])
-        monkeypatch.setattr(module, "_costs", lambda _args, focals, c=costs: next(c))
+        costs = iter([lambda n, c=curve: c, lambda n: 1.1 - 0.1 * np.hanning(n)])
+        monkeypatch.setattr(module, "_costs", lambda _args, focals, c=costs: next(c)(len(focals)))
         assert (estimate_focal(*args).focal is not None) is pinned
