@@ -24,6 +24,8 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from flow.base import to_grey
+
 WINDOW = 7  # px at the flow's size: about DIS's patch
 # (grey levels / px)²: a flat patch's sensor and codec noise reads 0.05–0.3 on the real
 # clips (their 10th percentile), an edge's weak direction about as little. At 1, the
@@ -45,8 +47,8 @@ def min_eigenvalue(frame: NDArray) -> NDArray[np.float32]:
     :func:`min_eigenvalue_at` took 0.19 at the sample grid's points), with the gradient
     divided by 4·WINDOW·255 and the window summed, not averaged; the factor undoes both.
     """
-    grey = frame if frame.ndim == 2 else cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
-    lam = cv2.cornerMinEigenVal(np.ascontiguousarray(grey, np.uint8), WINDOW, ksize=3)
+    grey = np.ascontiguousarray(to_grey(frame), np.uint8)
+    lam = cv2.cornerMinEigenVal(grey, WINDOW, ksize=3)
     return lam * np.float32(OPENCV_SCALE)
 
 
@@ -60,8 +62,7 @@ def min_eigenvalue_at(frame: NDArray, rows: NDArray, cols: NDArray) -> NDArray[n
     frames came out one bit apart, none near the threshold): 0.19 ms a frame against
     1.85 for the whole map, on the thread that computes the flow.
     """
-    grey = frame if frame.ndim == 2 else cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
-    grey = np.ascontiguousarray(grey, np.uint8)
+    grey = np.ascontiguousarray(to_grey(frame), np.uint8)
     scale = 1.0 / (4 * WINDOW * 255)  # cornerMinEigenVal's, undone by OPENCV_SCALE
     gx = cv2.Sobel(grey, cv2.CV_32F, 1, 0, ksize=3, scale=scale)
     gy = cv2.Sobel(grey, cv2.CV_32F, 0, 1, ksize=3, scale=scale)

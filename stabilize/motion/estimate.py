@@ -143,7 +143,8 @@ def with_bands(estimator: HoughEstimator, track: VisualTrack, bands: int) -> Vis
     """The track with each pair's rotation also estimated from ``bands`` horizontal
     bands of its kept samples, by the ``estimator`` its rotations came from: pass 1
     leaves the bands to this when the focal length may still change, since a new one
-    estimates them again anyway (1080p, 10 s: about 1 s of pass 1)."""
+    estimates them again anyway (1080p, 10 s: about 1 s of pass 1 saved when this came,
+    before the bands were voted in one call a chunk)."""
     if not bands:
         return track
     samples = track.samples
@@ -151,7 +152,7 @@ def with_bands(estimator: HoughEstimator, track: VisualTrack, bands: int) -> Vis
     found: list[list[tuple]] = [[] for _ in masks]
     for part in _chunks(len(samples.u)):
         u, v, valid = samples.u[part], samples.v[part], samples.valid[part]
-        _vote_bands(estimator, u, v, valid, masks, found)
+        _vote_sets(estimator, u, v, [valid & mask for mask in masks], found)
     R_b, rows_b, support_b = _stacked(found)
     return replace(track, bands=R_b, band_rows=rows_b, band_support=support_b)
 
@@ -245,40 +246,29 @@ def _vote(
     ones; returns the similarity (n, 4) each whole-frame rotation leaves on the measured
     vectors."""
     grid = estimator.grid
-    estimates = _estimated(estimator, u, v, [measured, *(valid & mask for mask in masks)])
-    for into, part in zip(found, estimates, strict=True):
-        _note(estimator, part, into)
-    R = np.array([est.matrix for est in estimates[0]])
+    votes = [measured, *(valid & mask for mask in masks)]
+    R = np.array([est.matrix for est in _vote_sets(estimator, u, v, votes, found)[0]])
     return residual_motion(grid.x, grid.y, u, v, measured, R, estimator.focal)
 
 
-def _vote_bands(
-    estimator: HoughEstimator,
-    u: NDArray,
-    v: NDArray,
-    valid: NDArray,
-    masks: list[NDArray],
-    found: list[list[tuple]],
-) -> None:
-    """(R, support, mean row) of each pair's bands (their ``masks``) into ``found``."""
-    estimates = _estimated(estimator, u, v, [valid & mask for mask in masks])
-    for into, part in zip(found, estimates, strict=True):
-        _note(estimator, part, into)
-
-
-def _estimated(
-    estimator: HoughEstimator, u: NDArray, v: NDArray, votes: list[NDArray]
+def _vote_sets(
+    estimator: HoughEstimator, u: NDArray, v: NDArray, votes: list[NDArray], found: list
 ) -> list[list]:
     """The n pairs' rotations (u, v (n, M)) from each of ``votes``' sets of vectors
-    (n, M), in one call: a call per band and chunk spent much of the bands' time
-    starting threads and waiting on the slowest (with_bands on 1080p, 10 s: 0.37–0.42 s
-    so, 0.22–0.28 s with this and the mean rows stacked)."""
+    (n, M), their (R, support, mean row) into the matching list of ``found``; returns
+    the estimates, a list per set. One call for every set: a call per band and chunk
+    spent much of the bands' time starting threads and waiting on the slowest
+    (with_bands on 1080p, 10 s: 0.37–0.42 s so, 0.22–0.28 s with this and the mean rows
+    stacked)."""
     n = len(u)
     times = len(votes)
-    estimates = estimator.estimate_samples(
+    stacked = estimator.estimate_samples(
         np.tile(u, (times, 1)), np.tile(v, (times, 1)), np.concatenate(votes)
     )
-    return [estimates[k * n : (k + 1) * n] for k in range(times)]
+    estimates = [stacked[k * n : (k + 1) * n] for k in range(times)]
+    for into, part in zip(found, estimates, strict=True):
+        _note(estimator, part, into)
+    return estimates
 
 
 def _note(estimator: HoughEstimator, estimates: list, into: list[tuple]) -> None:
