@@ -157,8 +157,10 @@ class HoughEstimator:
     def estimate_samples(self, u: NDArray, v: NDArray, valid: NDArray) -> list[RotationEstimate]:
         """Rotations of sampled fields (N, M) (:meth:`samples`); what
         :meth:`estimate_many` does after sampling."""
-        u, v = np.asarray(u, np.float64), np.asarray(v, np.float64)
-        valid = np.asarray(valid, np.bool_)
+        # row-major, whatever the caller's layout: a field's row is then contiguous, and
+        # the kernel is loaded for one signature (a second cost 25–50 ms a process)
+        u, v = np.ascontiguousarray(u, np.float64), np.ascontiguousarray(v, np.float64)
+        valid = np.ascontiguousarray(valid, np.bool_)
         n = len(u)
         threads = max(1, min(n, get_num_threads()))
         chunks = min(n, 2 * threads)
@@ -193,6 +195,18 @@ class HoughEstimator:
         n_valid = int(valid.sum())
         support = count / n_valid if n_valid >= MIN_VECTORS else 0.0
         return RotationEstimate(R, rotvec, float(support), inliers.reshape(self.grid.shape))
+
+
+def warm_up() -> None:
+    """Load the estimator's kernels now, from numba's cache (or compiled, the first time).
+
+    A process's first kernel call also sets numba itself up: 0.2 s before the first
+    frame was decoded (1080p, 10 s, this 2-core machine), and the main kernel's load
+    50 ms more. Called on a thread while FFmpeg probes the file, that time is spent
+    waiting on FFmpeg instead."""
+    estimator = HoughEstimator((16, 16), 16.0, step=8)
+    m = len(estimator.grid.x)
+    estimator.estimate_samples(np.zeros((1, m)), np.zeros((1, m)), np.zeros((1, m), np.bool_))
 
 
 def estimate(flow: NDArray, focal: float, **options) -> RotationEstimate:

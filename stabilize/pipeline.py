@@ -22,6 +22,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from functools import partial
 from pathlib import Path
+from threading import Thread
 
 import numpy as np
 from numpy.typing import NDArray
@@ -29,6 +30,7 @@ from numpy.typing import NDArray
 import flow
 from rotation import so3
 from rotation.camera import intrinsics
+from rotation.hough import warm_up
 from stabilize.gyro.log import GyroLog
 from stabilize.motion.estimate import READOUT_BANDS
 from stabilize.motion.focal import estimate_motion
@@ -85,6 +87,7 @@ def stabilize_video(
     """
     settings = settings or Settings()
     src, dst = Path(input_path), Path(output_path)
+    Thread(target=warm_up, name="warm-up", daemon=True).start()  # while FFmpeg probes
     job = prepare(src, dst, settings, overwrite)
     tell = notify or (lambda _: None)
     for notice in (*job.notices, *compiling_notice()):

@@ -82,9 +82,10 @@ def estimate_rotations(
     masks = band_masks(estimator, ws.size[0], bands)
     textures: deque[NDArray] = deque()  # each frame's measurable vectors, until its pair
     noted = _noting_texture(frames, estimator.grid, textures)
-    # A chunk's vote runs while the next chunk's flow is computed: the flow keeps one
-    # core busy, the vote both; without the overlap, pass 1 used 1.65 of this machine's
-    # 2 cores (1080p, 10 s, with the bands' votes below: 7.8 s, 7.0 with it)
+    # A chunk's vote runs while the next chunk's flow is computed: without the overlap,
+    # pass 1 used 1.65 of this machine's 2 cores (1080p, 10 s, with the bands' votes
+    # below: 7.8 s, 7.0 with it), when the flow kept one core busy; it now takes pairs
+    # two at a time (flow.dis), and the vote fills the gaps its threads leave
     voting: Future | None = None
     with ThreadPoolExecutor(1) as voter:
         for u, v, valid in _sampled(estimator, backend.many(noted)):

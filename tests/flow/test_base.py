@@ -1,3 +1,4 @@
+import cv2
 import numpy as np
 import pytest
 
@@ -32,12 +33,16 @@ def test_dis_odd_size_grey_and_rgb():
 
 
 def test_dis_many_matches_pairs():
-    frames = [shifted_pair(64, 96, k, 0)[1] for k in range(4)]
+    # more pairs than are computed at once, each shift its own, so that a flow out of
+    # order shows; OpenCV's threads are handed back after
+    threads = cv2.getNumThreads()
+    frames = [shifted_pair(64, 96, (k * k) % 5, k % 3)[1] for k in range(10)]
     backend = flow.get("dis")
     many = list(backend.many(iter(frames)))
-    assert len(many) == 3
+    assert len(many) == 9
     for k, f in enumerate(many):
         np.testing.assert_array_equal(f, backend(frames[k], frames[k + 1]))
+    assert cv2.getNumThreads() == threads
 
 
 @pytest.mark.parametrize(
@@ -48,8 +53,10 @@ def test_mismatched_sizes_raise(bad):
     frame = np.zeros((60, 60, 3), np.uint8)
     with pytest.raises(ValueError, match="sizes differ"):
         flow.get("dis")(frame, bad)
+    threads = cv2.getNumThreads()
     with pytest.raises(ValueError, match="sizes differ"):
-        list(flow.get("dis").many([frame, bad]))
+        list(flow.get("dis").many([frame, frame, bad]))
+    assert cv2.getNumThreads() == threads
 
 
 def test_bad_frames_raise():
