@@ -178,3 +178,21 @@ def test_focal_and_principal_point_scale_with_the_flow():
     # Forgetting to rescale the focal length is a gross error.
     wrong = HoughEstimator(SIZE, K[0, 0], center=(K2[0, 2], K2[1, 2])).estimate(small)
     assert so3.angular_error_deg(wrong.matrix, R) > 0.2
+
+
+def test_any_layout_runs_one_loaded_kernel():
+    # warm_up loads the kernel the pipeline runs; samples in either memory layout must
+    # reach it as they are, not load a second signature (25–50 ms a process), and give
+    # the same rotations
+    from rotation.hough import estimate_chunk, warm_up
+
+    warm_up()
+    estimator = HoughEstimator((270, 480), 413.75)
+    turns = [so3.exp_so3([0.0, 0.004 * k, 0.001]) for k in (1, 2)]
+    flows = np.stack([rotation_flow(R, 413.75, (270, 480)) for R in turns])
+    u, v, valid = estimator.samples(flows)
+    rows = estimator.estimate_samples(np.ascontiguousarray(u), np.ascontiguousarray(v), valid)
+    columns = estimator.estimate_samples(np.asfortranarray(u), np.asfortranarray(v), valid)
+    assert len(estimate_chunk.signatures) == 1
+    for a, b in zip(rows, columns, strict=True):
+        np.testing.assert_array_equal(a.matrix, b.matrix)
