@@ -56,7 +56,8 @@ class DISFlow:
         the frames come. On 2 cores (1080p, 10 s, pass 1 with its votes beside it) that
         took 3.2–3.3 s instead of 3.9, the flows identical to the bit.
         """
-        workers = max(1, cv2.getNumThreads())
+        threads = cv2.getNumThreads()  # handed back as found
+        workers = max(1, threads)
         pending: deque = deque()
         previous = None
         cv2.setNumThreads(1)
@@ -76,7 +77,7 @@ class DISFlow:
                 while pending:
                     yield pending.popleft().result()
         finally:
-            cv2.setNumThreads(workers)
+            cv2.setNumThreads(threads)
 
     def _create(self) -> cv2.DISOpticalFlow:
         opencv_preset, finest = PRESETS[self.preset]

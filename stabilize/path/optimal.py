@@ -228,7 +228,8 @@ def _shake_cost(p0: NDArray, sigma: float) -> tuple[sparse.csc_array, NDArray] |
 
     c₀ = ½ ‖(I - G_σ) Δp0‖², the target's own shake, is the unit. In rad² the objective
     is about 1e-7, where Clarabel's absolute tolerances (1e-8) end the solve early: on
-    karma 0.03–0.1% above the optimum, the path up to 0.4 px off it.
+    karma 0.03–0.1% above the optimum, the path up to 0.4 px off it. P is given as its
+    upper triangle, the form Clarabel takes, made once for every solve of the window.
     """
     n, k = p0.shape
     if n < 3:
@@ -237,7 +238,7 @@ def _shake_cost(p0: NDArray, sigma: float) -> tuple[sparse.csc_array, NDArray] |
     shake = H @ p0.ravel()
     unit = 0.5 * float(shake @ shake) or 1.0
     P = (H.T @ H + HOLD * sparse.eye_array(n * k)) / unit
-    return P.tocsc(), H.T @ shake / unit
+    return sparse.triu(P).tocsc(), H.T @ shake / unit
 
 
 def _programme(
@@ -266,8 +267,9 @@ def _programme(
     b = np.concatenate([crop[1], upper[capped]])
     rows = np.flatnonzero(b - A @ x0.ravel() < NEAR)
     held = np.arange(fixed * k)
+    equal = (_picking(held, nx), x0.ravel()[held])  # the held frames: δ = x0 there
     while True:
-        x = _solve(cost, (_picking(held, nx), x0.ravel()[held]), (A[rows], b[rows]))
+        x = _solve(cost, equal, (A[rows], b[rows]))
         if x is None:
             return None
         broken = np.setdiff1d(np.flatnonzero(A @ x - b > BROKEN), rows)
@@ -282,7 +284,7 @@ def _solve(
     below: tuple[sparse.csr_array, NDArray],
 ) -> NDArray | None:
     """argmin ½ xᵀP x + qᵀx subject to E x = e and A x ≤ b, by Clarabel; None where it
-    finds no answer. ``cost`` (P, q), ``equal`` (E, e), ``below`` (A, b)."""
+    finds no answer. ``cost`` (P's upper triangle, q), ``equal`` (E, e), ``below`` (A, b)."""
     import clarabel  # loaded with the first programme, not with the planner
 
     (P, q), (E, e), (A, b) = cost, equal, below
@@ -292,9 +294,7 @@ def _solve(
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     stacked = sparse.vstack([E, A]).tocsc()
-    solver = clarabel.DefaultSolver(
-        sparse.triu(P).tocsc(), q, stacked, np.concatenate([e, b]), cones, settings
-    )
+    solver = clarabel.DefaultSolver(P, q, stacked, np.concatenate([e, b]), cones, settings)
     solution = solver.solve()
     if solution.status not in (clarabel.SolverStatus.Solved, clarabel.SolverStatus.AlmostSolved):
         return None
