@@ -65,6 +65,43 @@ def test_a_curve_flat_on_one_side_pins_nothing_down(monkeypatch):
     zeros = np.zeros((40, len(est.grid.x)))
     args = (est.grid.x, est.grid.y, zeros, zeros, zeros == 0, np.zeros((40, 3)), start, BOUNDS)
     for curve, pinned in ((floor, False), (dip, True), (narrow, True)):
-        costs = iter([lambda n, c=curve: c, lambda n: 1.1 - 0.1 * np.hanning(n)])
-        monkeypatch.setattr(module, "_costs", lambda _args, focals, c=costs: next(c)(len(focals)))
+
+        def costs(_args, focals, rounds, coarse=curve):  # the fine grid's: a bowl
+            return coarse if len(focals) == module.COARSE else np.log(focals / 200.0) ** 2
+
+        monkeypatch.setattr(module, "_costs", costs)
         assert (estimate_focal(*args).focal is not None) is pinned
+
+
+@pytest.mark.parametrize("low", [0, 2, 4, 5, 8])
+def test_the_fine_grid_is_walked_down_to_its_minimum(low):
+    """Downhill from the middle, reading a few candidates: the whole grid's minimum
+    wherever it has one, its end where the curve falls all the way."""
+    from rotation.focal import _descend
+
+    curve = (np.arange(9) - low) ** 2.0
+    read = []
+
+    def costs_of(ks):
+        read.extend(ks)
+        return curve[ks]
+
+    costs, j = _descend(costs_of, 9, toward=-1 if low < 4 else 1)
+    assert j == low and costs[j] == 0.0
+    assert len(read) == len(set(read)) < 9 or low in (0, 8)
+    assert all(np.isfinite(costs[max(j - 1, 0) : j + 2]))
+
+
+def test_the_coarse_grid_reads_a_third_of_the_samples_to_the_frame_edges():
+    from rotation.focal import THIN, thinned
+
+    est = HoughEstimator(SIZE, focal_from_fov(69.0, SIZE[1]))
+    x, y = est.grid.x, est.grid.y
+    u = np.arange(3 * len(x), dtype=float).reshape(3, -1)
+    tx, ty, tu, *_ = thinned((x, y, u, u, u > 0, np.zeros((3, 3)), 1.0), THIN)
+    assert len(tx) == pytest.approx(len(x) / THIN, abs=1)
+    assert (tx.min(), tx.max(), ty.min(), ty.max()) == (x.min(), x.max(), y.min(), y.max())
+    for column in np.unique(x):  # each column keeps its share of the rows
+        assert (tx == column).sum() == pytest.approx((x == column).sum() / THIN, abs=1)
+    kept = np.isin(x + 1j * y, tx + 1j * ty)  # each kept sample's flow comes with it
+    assert np.array_equal(tu, u[:, kept])

@@ -55,8 +55,10 @@ def test_a_real_narrow_clip_is_estimated(shared, tmp_path, crop):
     # about the principal point (406.01, 309.01), shown at 640×480, so f is 573.85 px
     # times the zoom, where the 69° default (465.6 px) is 59% and 70% short. Their cost
     # curves rise 0.15–0.30% and 0.13–0.82% two coarse candidates past the minimum, 0.38%
-    # and 0.41% at 15°. Measured: +3.7% and -4.8% (-1.2% and -2.7% before the texture
-    # gate; decoded to grey instead of RGB, the 31° crop read +8.0%; the same 31° crop of
+    # and 0.41% at 15°. Measured: +3.7% and -0.7% (the 24° crop's fine grid has two
+    # minima: read whole, it gave the lower one, -4.8%; walked down from the coarse
+    # minimum, it gives the nearer; -1.2% and -2.7% before the texture gate; decoded to
+    # grey instead of RGB, the 31° crop read +8.0%; the same 31° crop of
     # an H.264 copy of the frames, encoded twice, read +8%: its curve rose 0.09% two out,
     # which a rule asking for the rise there refused).
     frames = shared / "data" / "phone-cc9" / "frames" / "RE_frame-%d.jpg"
