@@ -86,7 +86,7 @@ def test_the_fine_grid_is_walked_down_to_its_minimum(low):
         read.extend(ks)
         return curve[ks]
 
-    costs, j = _descend(costs_of, 9, toward=-1 if low < 4 else 1)
+    costs, j = _descend(costs_of, 9)
     assert j == low and costs[j] == 0.0
     assert len(read) == len(set(read)) < 9 or low in (0, 8)
     assert all(np.isfinite(costs[max(j - 1, 0) : j + 2]))
@@ -105,3 +105,22 @@ def test_the_coarse_grid_reads_a_third_of_the_samples_to_the_frame_edges():
         assert (tx == column).sum() == pytest.approx((x == column).sum() / THIN, abs=1)
     kept = np.isin(x + 1j * y, tx + 1j * ty)  # each kept sample's flow comes with it
     assert np.array_equal(tu, u[:, kept])
+
+
+def test_a_candidate_split_between_threads_costs_what_it_costs_whole(monkeypatch):
+    """The fine grid's reads split each candidate's pairs, then its sample positions,
+    between the threads: the same sum as the one-thread reading, to the bit."""
+    from rotation import focal as module
+
+    start = focal_from_fov(69.0, SIZE[1])
+    est = HoughEstimator(SIZE, start, max_deg=15)
+    data = make_set("street", 40, seed=3, focal=focal_from_fov(45.0, SIZE[1]), max_deg=1.0)
+    u, v, valid = est.samples(data.flows)
+    rotvecs = np.array([r.rotvec for r in est.estimate_samples(u, v, valid)])
+    args = (est.grid.x, est.grid.y, u, v, valid, rotvecs, start)
+    focals = np.array([0.8, 1.3]) * start
+    whole = [module.cost(*args, f) for f in focals]
+    for threads in (2, 3):  # a split into as many parts, read one candidate at a time
+        monkeypatch.setattr(module, "get_num_threads", lambda t=threads: t)
+        split = [module._costs(args, focals[k : k + 1], module.REFIT_ROUNDS)[0] for k in (0, 1)]
+        assert split == whole
