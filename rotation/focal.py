@@ -115,7 +115,12 @@ def residual_fields(x, y, U, V, VALID, W0, f0, f, rounds=REFIT_ROUNDS) -> np.nda
 def cost(x, y, u, v, valid, rotvecs, f0: float, f: float, rounds: int = REFIT_ROUNDS) -> float:
     """C(f) of the module docstring, each rotation refitted in ``rounds`` rounds."""
     d = residual_fields(x, y, u, v, valid, rotvecs, f0, f, rounds)
-    r2 = np.sum((d - running_median(d, valid)) ** 2, axis=-1)
+    return _truncated_sum(d, running_median(d, valid), valid)
+
+
+def _truncated_sum(d: NDArray, slow: NDArray, valid: NDArray) -> float:
+    """Σ min(|d - d̄|², c²) over the valid vectors, d̄ = ``slow`` (the running median)."""
+    r2 = np.sum((d - slow) ** 2, axis=-1)
     return float(np.sum(np.minimum(r2, CLIP_PX**2) * valid))
 
 
@@ -250,9 +255,9 @@ def _costs(args: tuple, focals: NDArray, rounds: int) -> NDArray[np.float64]:
     """C(f) (:func:`cost`) for each candidate, on every core (the kernels release the
     GIL): a candidate per thread where there are as many, else each candidate split
     between the threads, its pairs' refits, then its sample positions' running medians.
-    The same sums either way. Split, a read of the 1080p clip's 120 pairs takes 27 ms
-    instead of 38; the coarse grid's cheap reads take 4.3 ms each a thread apiece, 3 ms
-    more split."""
+    The same sums either way. A lone read of the 1080p clip's 120 pairs takes 27 ms
+    split, against 38 on one thread; the coarse grid's 25 cheap reads, a thread apiece,
+    took 76 ms, and 107 split (each split read has its own overhead)."""
     threads = max(1, get_num_threads())
     with ThreadPoolExecutor(threads) as pool:
         if len(focals) >= threads:
@@ -269,14 +274,13 @@ def _split_cost(pool, threads: int, args: tuple, f: float, rounds: int) -> float
     def fields(part: slice) -> NDArray:
         return residual_fields(x, y, u[part], v[part], valid[part], rotvecs[part], f0, f, rounds)
 
+    d = np.concatenate(list(pool.map(fields, pairs)))
+
     def medians(part: slice) -> NDArray:
         d_at, valid_at = (np.ascontiguousarray(a[:, part]) for a in (d, valid))
         return _running_median(d_at, valid_at, WINDOW)
 
-    d = np.concatenate(list(pool.map(fields, pairs)))
-    slow = np.concatenate(list(pool.map(medians, points)), axis=1)
-    r2 = np.sum((d - slow) ** 2, axis=-1)
-    return float(np.sum(np.minimum(r2, CLIP_PX**2) * valid))
+    return _truncated_sum(d, np.concatenate(list(pool.map(medians, points)), axis=1), valid)
 
 
 def _bounds(n: int, parts: int) -> list[tuple[int, int]]:
