@@ -3,12 +3,14 @@ estimated from the clip's own flow (:mod:`rotation.focal`), in that order of tru
 
 A wrong focal length is not harmless: rotational flow carries x²/f and xy/f terms at the
 frame's edges, so a wrong f leaves keystone wobble there and mixes the axes. With no
-``--fov``, ``--focal`` or ``--lens`` (``--fov auto``), pass 1 runs at the metadata's focal
-length (or the 69° default), the focal length is estimated from the flow vectors it kept,
-and every rotation is estimated again at it, without decoding the clip a second time. An
-estimate within 15% of the metadata's keeps the metadata's (the finer figure); a clip
-that does not pin f down (a tripod, pure roll, too little motion) keeps the starting
-value, and says so.
+``--fov``, ``--focal`` or ``--lens`` (``--fov auto``), pass 1 starts at the metadata's
+focal length (or the 69° default). Once it has voted the clip's first ``MAX_PAIRS`` pairs,
+the focal length is estimated from the flow vectors they kept; those pairs are voted again
+at it, and the rest of the clip only at it, without decoding anything twice. Where the
+clip's start does not pin f down, the estimate is made at the end, on the clip's most
+turning ``MAX_PAIRS`` pairs, and every pair is voted again. An estimate within 15% of the
+metadata's keeps the metadata's (the finer figure); a clip that does not pin f down (a
+tripod, pure roll, too little motion) keeps the starting value, and says so.
 
 Phones write a 35 mm-equivalent focal length F (QuickTime's
 ``com.apple.quicktime.camera.focal_length.35mm_equivalent``, EXIF's
@@ -31,7 +33,7 @@ import flow
 from rotation import HoughEstimator, so3
 from rotation.camera import focal_from_fov, fov_from_focal
 from rotation.focal import estimate_focal
-from stabilize.motion.estimate import estimate_again, estimate_rotations, with_bands
+from stabilize.motion.estimate import Settle, estimate_again, estimate_rotations, with_bands
 from stabilize.motion.track import VisualTrack
 from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
@@ -134,37 +136,61 @@ def estimate_motion(
 ) -> tuple[VisualTrack, FocalChoice]:
     """Pass 1 with the focal length resolved: the track, and the focal length it was
     estimated at (:class:`FocalChoice`); with ``keep_samples``, the track keeps its flow
-    vectors (they are kept while the focal length is estimated, and dropped after)."""
+    vectors (they are kept while the focal length is estimated, and dropped after).
+    The estimate is tried once pass 1 has voted ``MAX_PAIRS`` pairs (a whole number of
+    chunks: 128), and again at the end where those do not pin it down."""
     choice = initial_focal(settings, info, lens)
     auto = choice.source in ("metadata", "default")  # nothing given: estimated
-    at_start = replace(settings, focal=choice.px, fov=None)
+    ws = flow.working_size(info.size)
+    start = HoughEstimator(ws.size, choice.px * ws.scale[0], max_deg=settings.max_deg)
+    width = info.width * ws.scale[0]
+    settled: list[FocalChoice] = []
+
+    def estimator(resolved: FocalChoice) -> HoughEstimator:
+        if resolved.source != "estimated":
+            return start
+        return HoughEstimator(ws.size, resolved.px * ws.scale[0], max_deg=settings.max_deg)
+
+    def settle(so_far: VisualTrack) -> HoughEstimator | None:
+        found = focal_from_track(so_far, start, width)
+        if found is None:
+            return None
+        settled.append(_resolved(choice, found / ws.scale[0]))
+        return estimator(settled[0])
+
     track = estimate_rotations(
         path,
         info,
-        at_start,
+        replace(settings, focal=choice.px, fov=None),
         progress,
         times,
-        bands=0 if auto else bands,  # with the focal length settled (with_bands)
+        bands=bands,
         lens=lens,
-        keep_samples=auto or keep_samples,
+        keep_samples=keep_samples,
+        settle=Settle(MAX_PAIRS, settle) if auto else None,
     )
-    if not auto:
-        return track, choice
+    if not auto or settled:  # the samples dropped unless asked for
+        return track, settled[0] if settled else choice
     kept = (lambda t: t) if keep_samples else (lambda t: replace(t, samples=None))
-    ws = flow.working_size(info.size)
-    start = HoughEstimator(ws.size, choice.px * ws.scale[0], max_deg=settings.max_deg)
-    found = focal_from_track(track, start, info.width * ws.scale[0])
+    found = focal_from_track(track, start, width)
     if found is None:
         note = f"the clip's motion does not pin the focal length down: {choice.source} kept"
         return kept(with_bands(start, track, bands)), replace(choice, note=note)
-    px = found / ws.scale[0]
-    meta = choice.metadata_px
-    if meta and abs(px / meta - 1) <= DISAGREES:  # agreed: the lens's own figure is finer
-        return kept(with_bands(start, track, bands)), replace(choice, estimated_px=px)
+    resolved = _resolved(choice, found / ws.scale[0])
+    if resolved.source != "estimated":
+        return kept(with_bands(start, track, bands)), resolved
+    return kept(estimate_again(estimator(resolved), track, bands)), resolved
+
+
+def _resolved(start: FocalChoice, px: float) -> FocalChoice:
+    """The focal length kept once the clip's estimate is ``px`` (the input's px): the
+    metadata's where the two agree (the lens's own figure is the finer), else the
+    estimate, noted where it disagrees with the metadata."""
+    meta = start.metadata_px
+    if meta and abs(px / meta - 1) <= DISAGREES:
+        return replace(start, estimated_px=px)
     note = f"{100 * (px / meta - 1):+.0f}% off the metadata's (a digital zoom?)" if meta else ""
-    estimator = HoughEstimator(ws.size, found, max_deg=settings.max_deg)
-    again = estimate_again(estimator, track, bands)
-    return kept(again), FocalChoice(px, info.width, "estimated", px, meta, note)
+    return FocalChoice(px, start.width, "estimated", px, meta, note)
 
 
 def focal_from_track(track: VisualTrack, estimator: HoughEstimator, width: float) -> float | None:

@@ -76,3 +76,37 @@ def test_bands_voted_from_the_kept_samples_are_those_of_pass_1():
     assert not np.array_equal(inline.bands[0], inline.rotations)  # the bands are their own
     edges = np.linspace(0.0, 1.0, 7)[:, None]  # each band's vectors lie in it
     assert ((later.band_rows >= edges[:-1] - 0.02) & (later.band_rows <= edges[1:])).all()
+
+
+def test_a_focal_length_settled_mid_stream_votes_as_if_given():
+    """Settled after the first chunk, pass 1 gives what a run at that focal length
+    gives (the pairs so far voted again from their samples, bands and all); declined,
+    what a run without it gives, bands left out and samples kept."""
+    clip = SAMPLE / "clip.mp4"
+    info = probe(clip)
+    ws = flow.working_size(info.size)
+    focal = float(json.loads((SAMPLE / "truth.json").read_text())["K"][0][0])
+    at_start = Settings(fov=50.0)  # the sample's is 70°
+    shown = []
+
+    def choose(so_far):
+        shown.append(so_far)
+        return estimate.HoughEstimator(ws.size, focal * ws.scale[0], max_deg=at_start.max_deg)
+
+    settle = estimate.Settle(estimate.ESTIMATE_CHUNK, choose)
+    settled = estimate.estimate_rotations(clip, info, at_start, bands=6, settle=settle)
+    given = estimate.estimate_rotations(clip, info, Settings(focal=focal), bands=6)
+    start = estimate.estimate_rotations(clip, info, at_start, keep_samples=True)
+    assert len(shown) == 1 and len(shown[0].rotations) == estimate.ESTIMATE_CHUNK
+    np.testing.assert_array_equal(shown[0].samples.u, start.samples.u[: estimate.ESTIMATE_CHUNK])
+    np.testing.assert_array_equal(shown[0].rotations, start.rotations[: estimate.ESTIMATE_CHUNK])
+    assert settled.samples is None and len(settled.rotations) == len(given.rotations) == 89
+    for name in ("rotations", "support", "rows", "residual", "bands", "band_rows"):
+        np.testing.assert_allclose(getattr(settled, name), getattr(given, name), atol=1e-9)
+    assert so3.angular_error_deg(settled.rotations, start.rotations).max() > 0.01
+
+    declined = estimate.Settle(estimate.ESTIMATE_CHUNK, lambda so_far: None)
+    kept = estimate.estimate_rotations(clip, info, at_start, bands=6, settle=declined)
+    assert kept.bands is None and kept.samples is not None
+    np.testing.assert_array_equal(kept.rotations, start.rotations)
+    np.testing.assert_array_equal(kept.samples.u, start.samples.u)

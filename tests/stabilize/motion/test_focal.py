@@ -7,9 +7,12 @@ import subprocess
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+import stabilize.motion.focal as focal_module
 from stabilize import Settings
+from stabilize.motion.estimate import estimate_rotations
 from stabilize.motion.focal import FULL_FRAME_DIAGONAL_MM, estimate_motion, initial_focal
 from stabilize.video import ffmpeg_exe, probe
 
@@ -32,21 +35,54 @@ def test_the_metadata_focal_length_is_read(shaky, tmp_path):
     assert initial_focal(Settings(), probe(shaky), None).source == "default"
 
 
-def test_auto_moves_a_wrong_start_towards_the_truth(tmp_path):
+@pytest.fixture(scope="module")
+def narrow_walk(tmp_path_factory) -> Path:
+    """A rendered 40° clip, 2 s, of a shaken walk with a crowd."""
+    from stabilize.synth import SynthOptions, render_clip
+
+    folder = tmp_path_factory.mktemp("narrow")
+    options = SynthOptions(size=(180, 320), seconds=2.0, seed=11, shake_deg=1.5, crowd=4)
+    render_clip(folder, replace(options, hfov=40.0))
+    return folder / "clip.mp4"
+
+
+NARROW_TRUTH = 160.0 / math.tan(math.radians(20.0))
+
+
+def test_auto_moves_a_wrong_start_towards_the_truth(narrow_walk):
     # A 40° clip started from the 69° default (47% off). The estimate is not yet within
     # the 3% that issue #15 asks (walking parallax biases it long, +14% here), but it
     # must land far closer than where it started.
-    from stabilize.synth import SynthOptions, render_clip
-
-    options = SynthOptions(size=(180, 320), seconds=2.0, seed=11, shake_deg=1.5, crowd=4)
-    render_clip(tmp_path, replace(options, hfov=40.0))
-    truth = 160.0 / math.tan(math.radians(20.0))
-    clip = tmp_path / "clip.mp4"
-    track, focal = estimate_motion(clip, probe(clip), Settings(fov="auto"))
+    track, focal = estimate_motion(narrow_walk, probe(narrow_walk), Settings(fov="auto"))
     start = Settings().focal_px(320)
     assert focal.source == "estimated" and track.samples is None
-    assert abs(focal.px / truth - 1) < abs(start / truth - 1) / 3
+    assert abs(focal.px / NARROW_TRUTH - 1) < abs(start / NARROW_TRUTH - 1) / 3
     assert focal.summary()["fov_deg"] == pytest.approx(focal.fov_deg)
+
+
+def test_a_long_clip_is_voted_once_at_the_focal_length_of_its_start(narrow_walk, monkeypatch):
+    # The clip's 59 pairs are "long" once the estimate is made on 32: it is made on the
+    # first 32 alone, and every pair is voted at what they give, as if it had been
+    # given, bands and all
+    searched = []
+    search = focal_module.focal_from_track
+
+    def seen(track, *args):
+        searched.append(len(track.rotations))
+        return search(track, *args)
+
+    monkeypatch.setattr(focal_module, "MAX_PAIRS", 32)
+    monkeypatch.setattr(focal_module, "focal_from_track", seen)
+    info = probe(narrow_walk)
+    track, focal = estimate_motion(narrow_walk, info, Settings(), bands=6)
+    start = Settings().focal_px(320)
+    assert searched == [32] and focal.source == "estimated" and track.samples is None
+    assert abs(focal.px / NARROW_TRUTH - 1) < abs(start / NARROW_TRUTH - 1) / 3
+    given = estimate_rotations(narrow_walk, info, Settings(focal=focal.px), bands=6)
+    for name in ("rotations", "residual", "bands", "band_support"):
+        np.testing.assert_allclose(getattr(track, name), getattr(given, name), atol=1e-9)
+    kept, _ = estimate_motion(narrow_walk, info, Settings(), bands=6, keep_samples=True)
+    assert len(kept.samples.u) == 59
 
 
 @pytest.mark.parametrize("crop", ["320:240:246:189", "240:180:286:219"])  # 31°, 24°
