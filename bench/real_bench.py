@@ -115,9 +115,9 @@ def main() -> None:
             print(_row(name, tool, m, t))
         ratios.append(ours_m.residual_shake_px / theirs_m.residual_shake_px)
         if args.spread:
-            mine_all = _mirrored(mine, info.size, fps, ours_m)
-            theirs_all = _mirrored(theirs, info.size, fps, theirs_m)
-            print(f"{'':28s}{'mirrored':10s}ours {_span(mine_all)}, vid.stab {_span(theirs_all)}")
+            mine_all = mirrored(mine, info.size, fps, ours_m)
+            theirs_all = mirrored(theirs, info.size, fps, theirs_m)
+            print(f"{'':28s}{'mirrored':10s}ours {span(mine_all)}, vid.stab {span(theirs_all)}")
             mean_ratios.append(np.mean(mine_all) / np.mean(theirs_all))
     print(
         f"\nours ÷ vid.stab residual shake: median {statistics.median(ratios):.2f} "
@@ -146,7 +146,7 @@ FLIP = slice(None, None, -1)
 MIRRORS = ((slice(None), FLIP), (FLIP,), (FLIP, FLIP))
 
 
-def _mirrored(out: Path, size: tuple[int, int], fps: float, m) -> list[float]:
+def mirrored(out: Path, size: tuple[int, int], fps: float, m) -> list[float]:
     """The residual shake (px) of ``out`` as it is (``m``), and under each of
     ``MIRRORS``."""
     readings = [m.residual_shake_px]
@@ -156,7 +156,7 @@ def _mirrored(out: Path, size: tuple[int, int], fps: float, m) -> list[float]:
     return readings
 
 
-def _span(readings: list[float]) -> str:
+def span(readings: list[float]) -> str:
     """The readings' mean, and their range."""
     return f"{np.mean(readings):.3f} ({min(readings):.3f}–{max(readings):.3f})"
 
