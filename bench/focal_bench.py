@@ -35,15 +35,19 @@ from stabilize import Settings
 from stabilize.evaluate.metrics import evaluate_pair
 from stabilize.motion.focal import estimate_motion
 from stabilize.synth import SynthOptions, render_clip
-from stabilize.video import ffmpeg_exe, probe, read_frames
+from stabilize.video import probe, read_frames
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from real_bench import mirrored, span
+from real_bench import PHONE, ZOOM_CROP, mirrored, phone_clip, span
 
-PHONE = Path(__file__).resolve().parents[2] / "shared" / "data" / "phone-cc9" / "frames"
 PHONE_FOCAL = 573.85  # px at 640×480, its calibration
-# its frames' middle about the principal point (406.01, 309.01), shown at 640×480
-ZOOMS = {"whole": None, "zoom 31°": (320, 240, 246, 189), "zoom 24°": (240, 180, 286, 219)}
+# (FFmpeg filter, zoom): its frames' middle about the principal point (406.01, 309.01),
+# shown at 640×480
+ZOOMS = {
+    "whole": (None, 1.0),
+    "zoom 31°": (ZOOM_CROP, 2.0),
+    "zoom 24°": ("crop=240:180:286:219,scale=640:480", 640 / 240),
+}
 
 
 def rendered(work: Path, fov: float, seed: int) -> tuple[Path, float]:
@@ -53,15 +57,12 @@ def rendered(work: Path, fov: float, seed: int) -> tuple[Path, float]:
     return folder / "clip.mp4", json.loads((folder / "truth.json").read_text())["K"][0][0]
 
 
-def phone(work: Path, name: str, crop: tuple[int, int, int, int] | None) -> tuple[Path, float]:
-    """phone-cc9's frames as a clip, whole or a crop of them shown at 640×480, and the
-    focal length (px) that view has."""
+def phone(work: Path, name: str) -> tuple[Path, float]:
+    """phone-cc9's frames as a clip, whole or zoomed in (``ZOOMS``), and the focal
+    length (px) that view has."""
+    view, zoom = ZOOMS[name]
     clip = work / f"phone-cc9_{name.replace(' ', '').replace('°', '')}.mp4"
-    view = [] if crop is None else ["-vf", "crop={}:{}:{}:{},scale=640:480".format(*crop)]
-    pattern = ["-framerate", "30", "-start_number", "99", "-i", str(PHONE / "RE_frame-%d.jpg")]
-    cmd = [ffmpeg_exe(), "-v", "error", "-y", *pattern, *view, "-c:v", "libx264", "-crf", "12"]
-    subprocess.run([*cmd, "-pix_fmt", "yuv420p", str(clip)], check=True)
-    return clip, PHONE_FOCAL * (1.0 if crop is None else 640 / crop[0])
+    return phone_clip(clip, view), PHONE_FOCAL * zoom
 
 
 def shake(clip: Path, out: Path, options: list[str]) -> list[float]:
@@ -86,7 +87,7 @@ def main() -> None:
         (f"walk {fov:g}° seed {s}", *rendered(work, fov, s)) for fov in args.fov for s in args.seeds
     ]
     if PHONE.is_dir():
-        clips += [(f"phone-cc9 {name}", *phone(work, name, crop)) for name, crop in ZOOMS.items()]
+        clips += [(f"phone-cc9 {name}", *phone(work, name)) for name in ZOOMS]
     print(
         f"{'clip':26s}{'true f':>9s}{'found':>9s}{'source':>11s}{'error':>8s}{'pass 1 s':>10s}",
         end="",

@@ -54,21 +54,27 @@ RENDERED_FOV = (30.0, 45.0, 100.0)  # walks past near walls, at these unknown fi
 # principal point (406.01, 309.01), shown at 640×480: a real 31° clip whose f is known
 # (2 × 573.85 px), the kind of narrow clip (a zoo, a stage) where a wrong f shows most
 ZOOM_CROP = "crop=320:240:246:189,scale=640:480"
+PHONE = SHARED / "phone-cc9" / "frames"
+
+
+def phone_clip(out: Path, view: str | None = None) -> Path:
+    """phone-cc9's frames as an H.264 clip (CRF 12) at ``out``, through the FFmpeg filter
+    ``view`` where given."""
+    pattern = ["-framerate", "30", "-start_number", "99", "-i", str(PHONE / "RE_frame-%d.jpg")]
+    cmd = [ffmpeg_exe(), "-v", "error", "-y", *pattern, *(["-vf", view] if view else [])]
+    subprocess.run(
+        [*cmd, "-c:v", "libx264", "-crf", "12", "-pix_fmt", "yuv420p", str(out)], check=True
+    )
+    return out
 
 
 def clips(work: Path) -> list[Path]:
     """The real clips, phone-cc9's frames as a clip and zoomed in, and the rendered
     walks."""
     found = [SHARED / name for name in REAL if (SHARED / name).is_file()]
-    frames = SHARED / "phone-cc9" / "frames"
-    if frames.is_dir():
-        cc9 = work / "phone-cc9.mp4"
-        pattern = ["-framerate", "30", "-start_number", "99", "-i", str(frames / "RE_frame-%d.jpg")]
-        cmd = [ffmpeg_exe(), "-v", "error", "-y", *pattern, "-c:v", "libx264", "-crf", "12"]
-        zoomed = work / "phone-cc9-zoom31.mp4"
-        for out, view in ((cc9, []), (zoomed, ["-vf", ZOOM_CROP])):
-            subprocess.run([*cmd, *view, "-pix_fmt", "yuv420p", str(out)], check=True)
-            found.append(out)
+    if PHONE.is_dir():
+        found.append(phone_clip(work / "phone-cc9.mp4"))
+        found.append(phone_clip(work / "phone-cc9-zoom31.mp4", ZOOM_CROP))
     from stabilize.synth import SynthOptions, render_clip
 
     for fov in RENDERED_FOV:

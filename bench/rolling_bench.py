@@ -24,9 +24,11 @@ from pathlib import Path
 
 from stabilize.evaluate.metrics import evaluate_pair
 from stabilize.synth import SynthOptions, render_clip
-from stabilize.video import ffmpeg_exe, probe, read_frames
+from stabilize.video import probe, read_frames
 
-PHONE = Path(__file__).resolve().parents[2] / "shared" / "data" / "phone-cc9" / "frames"
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from real_bench import PHONE, phone_clip
+
 PHONE_FOCAL = "573.85"
 
 
@@ -50,14 +52,6 @@ def stabilise(clip: Path, out: Path, options: list[str], lens: list[str]) -> tup
     return json.loads(done.stdout), time.perf_counter() - start
 
 
-def phone_clip(work: Path) -> Path:
-    clip = work / "phone-cc9.mp4"
-    pattern = ["-framerate", "30", "-start_number", "99", "-i", str(PHONE / "RE_frame-%d.jpg")]
-    cmd = [ffmpeg_exe(), "-v", "error", "-y", *pattern, "-c:v", "libx264", "-crf", "12"]
-    subprocess.run([*cmd, "-pix_fmt", "yuv420p", str(clip)], check=True)
-    return clip
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--readouts", type=float, nargs="*", default=[0.0, 15.0, 25.0, 33.0])
@@ -73,7 +67,13 @@ def main() -> None:
         render_clip(folder, opts)
         runs.append((f"rendered, {ms:g} ms", folder / "clip.mp4", ["--fov", str(opts.hfov)]))
     if PHONE.is_dir():
-        runs.append(("phone-cc9 (gyro: 25.4 ms)", phone_clip(work), ["--focal", PHONE_FOCAL]))
+        runs.append(
+            (
+                "phone-cc9 (gyro: 25.4 ms)",
+                phone_clip(work / "phone-cc9.mp4"),
+                ["--focal", PHONE_FOCAL],
+            )
+        )
     print(
         f"{'clip':28s}{'readout found':>26s}{'shake auto/whole/off':>22s}"
         f"{'wobble auto/whole/off':>23s}{'distortion auto/whole/off':>27s}{'s auto/off':>12s}"

@@ -278,7 +278,7 @@ def _split_cost(pool, threads: int, args: tuple, f: float, rounds: int) -> float
 
     def medians(part: slice) -> NDArray:
         d_at, valid_at = (np.ascontiguousarray(a[:, part]) for a in (d, valid))
-        return _running_median(d_at, valid_at, WINDOW)
+        return running_median(d_at, valid_at)
 
     return _truncated_sum(d, np.concatenate(list(pool.map(medians, points)), axis=1), valid)
 
