@@ -16,6 +16,9 @@ ways (``real_bench.py --spread``), and the four readings' mean and range are giv
 
     python bench/focal_bench.py
     python bench/focal_bench.py --fov 110 --seeds 8 11 12 --shake
+    python bench/focal_bench.py --fov 30 --seeds 2 --walk 0    # the same hand, standing
+    python bench/focal_bench.py --fov 30 --flow raft    # RAFT's flow (its weights: README)
+    python bench/focal_bench.py --fov 30 --exact    # the search on the exact rotational flow
 """
 
 from __future__ import annotations
@@ -31,9 +34,15 @@ from pathlib import Path
 
 import numpy as np
 
+import flow
+from rotation import HoughEstimator, so3
+from rotation.camera import focal_from_fov
+from rotation.focal import estimate_focal
 from stabilize import Settings
 from stabilize.evaluate.metrics import evaluate_pair
-from stabilize.motion.focal import estimate_motion
+from stabilize.motion.estimate import estimate_rotations
+from stabilize.motion.files import read_rotations
+from stabilize.motion.focal import FOV_BOUNDS, MAX_PAIRS, estimate_motion, initial_focal
 from stabilize.synth import SynthOptions, render_clip
 from stabilize.video import probe, read_frames
 
@@ -41,6 +50,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from real_bench import PHONE, ZOOM_CROP, mirrored, phone_clip, span
 
 PHONE_FOCAL = 573.85  # px at 640×480, its calibration
+WALK = 1.4  # m/s
 # (FFmpeg filter, zoom): its frames' middle about the principal point (406.01, 309.01),
 # shown at 640×480
 ZOOMS = {
@@ -50,10 +60,11 @@ ZOOMS = {
 }
 
 
-def rendered(work: Path, fov: float, seed: int) -> tuple[Path, float]:
-    """A rendered walk at ``fov`` and its true focal length (px)."""
+def rendered(work: Path, fov: float, seed: int, walk: float = WALK) -> tuple[Path, float]:
+    """A rendered walk at ``fov`` (at ``walk`` m/s; 0: the same hand, standing) and its
+    true focal length (px)."""
     folder = work / f"walk{fov:g}_s{seed}"
-    render_clip(folder, SynthOptions(seed=seed, seconds=4.0, hfov=fov, walk=1.4))
+    render_clip(folder, SynthOptions(seed=seed, seconds=4.0, hfov=fov, walk=walk))
     return folder / "clip.mp4", json.loads((folder / "truth.json").read_text())["K"][0][0]
 
 
@@ -63,6 +74,30 @@ def phone(work: Path, name: str) -> tuple[Path, float]:
     view, zoom = ZOOMS[name]
     clip = work / f"phone-cc9_{name.replace(' ', '').replace('°', '')}.mp4"
     return phone_clip(clip, view), PHONE_FOCAL * zoom
+
+
+def exact_error(clip: Path, truth: float) -> float:
+    """The search's error (%) on a rendered walk with every kept vector replaced by the
+    flow its true rotation gives at its true focal length: no parallax, no crowd, no flow
+    error, so what is left is the search's own (the same pairs, samples and validity)."""
+    info = probe(clip)
+    size = flow.working_size(info.size)
+    start = initial_focal(Settings(), info, None)
+    track = estimate_rotations(clip, info, Settings(focal=start.px), keep_samples=True)
+    estimator = HoughEstimator(size.size, start.px * size.scale[0])
+    x, y, f = estimator.grid.x, estimator.grid.y, truth * size.scale[0]
+    rotations = read_rotations(clip.parent / "truth.csv")
+    pairs = min(len(track.rotations), MAX_PAIRS)
+    rays = so3.exp_so3(np.array([rotations[k] for k in range(pairs)])) @ np.stack(
+        [x, y, np.full_like(x, f)]
+    )
+    u, v = f * rays[:, 0] / rays[:, 2] - x, f * rays[:, 1] / rays[:, 2] - y
+    width = info.width * size.scale[0]
+    bounds = tuple(focal_from_fov(fov, width) for fov in FOV_BOUNDS[::-1])
+    rotvecs = so3.log_so3(track.rotations[:pairs])
+    valid = track.samples.valid[:pairs]
+    found = estimate_focal(x, y, u, v, valid, rotvecs, estimator.focal, bounds).focal
+    return math.nan if found is None else 100 * (found / f - 1)
 
 
 def shake(clip: Path, out: Path, options: list[str]) -> list[float]:
@@ -80,11 +115,18 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--fov", type=float, nargs="+", default=[30, 45, 70, 90, 100, 110])
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
+    parser.add_argument("--walk", type=float, default=WALK, help="walking speed, m/s (0: standing)")
+    parser.add_argument("--flow", default="dis", choices=sorted(flow.BACKENDS))
     parser.add_argument("--shake", action="store_true", help="stabilise each walk at both f")
+    parser.add_argument(
+        "--exact", action="store_true", help="also search each walk's exact rotational flow"
+    )
     args = parser.parse_args()
     work = Path(tempfile.mkdtemp(prefix="focal-bench-"))
     clips = [
-        (f"walk {fov:g}° seed {s}", *rendered(work, fov, s)) for fov in args.fov for s in args.seeds
+        (f"walk {fov:g}° seed {s}", *rendered(work, fov, s, args.walk))
+        for fov in args.fov
+        for s in args.seeds
     ]
     if PHONE.is_dir():
         clips += [(f"phone-cc9 {name}", *phone(work, name)) for name in ZOOMS]
@@ -92,12 +134,13 @@ def main() -> None:
         f"{'clip':26s}{'true f':>9s}{'found':>9s}{'source':>11s}{'error':>8s}{'pass 1 s':>10s}",
         end="",
     )
+    print(f"{'exact flow':>12s}" if args.exact else "", end="")
     print(f"   {'shake: true f (mirrored)':26s}  {'found':23s}" if args.shake else "")
     errors = []
     for name, clip, truth in clips:
         info = probe(clip)
         start = time.perf_counter()
-        _, focal = estimate_motion(clip, info, Settings())
+        _, focal = estimate_motion(clip, info, Settings(flow=args.flow))
         seconds = time.perf_counter() - start
         error = 100 * (focal.px / truth - 1)
         if focal.source == "estimated" and name.startswith("walk"):
@@ -105,10 +148,15 @@ def main() -> None:
         row = (
             f"{name:26s}{truth:9.1f}{focal.px:9.1f}{focal.source:>11s}{error:+7.1f}%{seconds:10.2f}"
         )
+        if args.exact and name.startswith("walk"):
+            row += f"{exact_error(clip, truth):+11.2f}%"
         if args.shake and name.startswith("walk"):
             fov = math.degrees(2 * math.atan(info.width / 2 / truth))
-            given = shake(clip, work / f"{clip.parent.name}_given.mp4", ["--fov", f"{fov:.4f}"])
-            found = shake(clip, work / f"{clip.parent.name}_found.mp4", [])
+            flows = ["--flow", args.flow]
+            given = shake(
+                clip, work / f"{clip.parent.name}_given.mp4", ["--fov", f"{fov:.4f}", *flows]
+            )
+            found = shake(clip, work / f"{clip.parent.name}_found.mp4", flows)
             ratio = 100 * (np.mean(found) / np.mean(given) - 1)
             row += f"   {span(given)}  {span(found)}  {ratio:+.1f}%"
         print(row, flush=True)
