@@ -37,6 +37,9 @@ class Container:
     options: tuple[str, ...] = ()
     hevc_tag: str | None = None  # the codec tag Apple players need for HEVC
     data: frozenset[str] = frozenset()  # data tracks held as they are, by codec tag
+    # Where a start timecode goes: "track" (written again from the video's timecode tag
+    # as a tmcd track, as QuickTime does), "tag" (kept as the video's tag), "" (nowhere)
+    timecode: str = ""
 
     def audio_codec(self, codec: str) -> str:
         """``copy`` for an audio codec held as it is, else the encoder it becomes."""
@@ -57,6 +60,7 @@ MP4 = Container(
     options=QUICKTIME,
     hevc_tag="hvc1",
     data=frozenset({"gpmd"}),  # GoPro's GPMF telemetry (its gyro): telemetry-parser reads it back
+    timecode="track",
 )
 
 # The registry: an output suffix → its container. Adding one is a line here.
@@ -70,6 +74,7 @@ CONTAINERS: dict[str, Container] = {
             {"subrip", "ass", "ssa", "webvtt", "hdmv_pgs_subtitle", "dvd_subtitle", "dvb_subtitle"}
         ),
         subtitle_encoder="srt",
+        timecode="tag",
     ),
     ".webm": Container(
         "webm",
@@ -78,6 +83,7 @@ CONTAINERS: dict[str, Container] = {
         "libopus",
         frozenset({"webvtt"}),
         "webvtt",
+        timecode="tag",
     ),
     ".avi": Container(
         "avi",

@@ -30,6 +30,7 @@ class Stream:
     start: float | None = None  # s, where FFmpeg lists one apart from the file's
     tag: str = ""  # the container's codec tag, e.g. 'avc1', 'text'
     title: str = ""  # its title ('name' in MP4, which FFmpeg writes back under another key)
+    timecode: str = ""  # SMPTE start timecode (HH:MM:SS:FF), where the stream carries one
 
 
 @dataclass(frozen=True)
@@ -84,10 +85,12 @@ _ROTATION = re.compile(r"rotation of (-?\d+(?:\.\d+)?) degrees|rotate\s*:\s*(-?\
 
 def _stream(match: re.Match, text: str) -> Stream:
     line = text[match.start() : text.find("\n", match.start())]
-    block = text[match.end() :].split("\n  Stream #", 1)[0]  # its Metadata: lines
+    # its Metadata: lines, up to the next stream (indented deeper within a stream group)
+    block = re.split(r"\n\s*Stream #", text[match.end() :], maxsplit=1)[0]
     title = re.search(r"^\s+(?:title|name)\s*: (.*)$", block, re.M)
     start = re.search(r", start (-?\d+(?:\.\d+)?)", line)
     tag = re.search(r"\((\w+) / 0x[0-9A-Fa-f]+\)", line)
+    timecode = re.search(r"^\s+timecode\s*: (\S+)", block, re.M | re.I)  # MKV: TIMECODE
     return Stream(
         int(match.group(1)),
         match.group(3).lower(),
@@ -96,6 +99,7 @@ def _stream(match: re.Match, text: str) -> Stream:
         float(start.group(1)) if start else None,
         tag.group(1) if tag else "",
         title.group(1).strip() if title else "",
+        timecode.group(1) if timecode else "",
     )
 
 

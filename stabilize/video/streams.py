@@ -7,7 +7,9 @@ does not (AAC into WebM becomes Opus, mov_text into MKV becomes SRT), and left o
 when the container cannot hold it at all, with a notice saying so. Per-stream metadata
 (language, title) comes with each track; the file's (creation time, location, title)
 and the video stream's own come from the source. The display rotation does not: the
-frames are written upright.
+frames are written upright. A start timecode (a camera's tmcd track, or a timecode tag)
+is set on the video, from which MP4 and MOV write a timecode track again; Matroska and
+WebM keep it as the video's tag, and other containers lose it, with a notice.
 """
 
 from __future__ import annotations
@@ -29,15 +31,17 @@ def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0
     notices: list[str] = []
     count = {"a": 0, "s": 0, "d": 0}
     kept: list[int] = []
+    timecode = _timecode(info)
     for stream in info.streams:
-        if _rebuilt(stream, info):
+        if _rebuilt(stream, info) or (_is_timecode(stream) and container.timecode == "track"):
             continue
         codec, flag = _codec(stream, container)
         where = _name(container)
         if codec is None:
-            what = stream.codec if stream.codec != "none" else stream.tag  # e.g. GoPro's tmcd
+            what = stream.codec if stream.codec != "none" else stream.tag  # e.g. GoPro's fdsc
             notices.append(
                 f"left out {stream.kind} #{stream.index} ({what}): {where} cannot hold it"
+                + (_where_timecode(timecode, container) if _is_timecode(stream) else "")
             )
             continue
         if codec != "copy":
@@ -47,6 +51,8 @@ def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0
         kept.append(stream.index)
     # One mapping per stream: any explicit one turns FFmpeg's per-stream default off.
     args += ["-map_metadata", "1", "-map_metadata:s:0", f"1:s:{_first_video(info)}"]
+    if timecode:
+        args += ["-metadata:s:0", f"timecode={timecode}"]
     titles = {s.index: s.title for s in info.streams}
     for out, index in enumerate(kept, start=1):
         args += [f"-map_metadata:s:{out}", f"1:s:{index}"]
@@ -73,6 +79,23 @@ def _rebuilt(stream: Stream, info: VideoInfo) -> bool:
     if stream.kind == "video":
         return stream.index == _first_video(info)
     return stream.kind == "data" and stream.tag == "text" and info.chapters > 0
+
+
+def _is_timecode(stream: Stream) -> bool:
+    return stream.kind == "data" and stream.tag == "tmcd" and bool(stream.timecode)
+
+
+def _timecode(info: VideoInfo) -> str:
+    """The source's start timecode: its video's, else its timecode track's, else none."""
+    video = [s.timecode for s in info.streams if s.kind == "video" and s.timecode]
+    track = [s.timecode for s in info.streams if _is_timecode(s)]
+    return next(iter(video + track), "")
+
+
+def _where_timecode(timecode: str, container: Container) -> str:
+    if container.timecode == "tag":
+        return f"; its timecode ({timecode}) is kept as the video's tag"
+    return f"; its timecode ({timecode}) is lost"
 
 
 def _first_video(info: VideoInfo) -> int:

@@ -155,3 +155,43 @@ def test_gopro_telemetry_is_kept(shared, tmp_path):
     assert not any("gpmd" in n or "bin_data" in n for n in summary["notices"])
     before = len(telemetry_parser.Parser(str(cut)).normalized_imu())
     assert before > 500 and len(telemetry_parser.Parser(str(out)).normalized_imu()) == before
+
+
+TIMECODE = "01:02:03:04"
+
+
+@pytest.fixture(scope="module")
+def timecoded(shaky, tmp_path_factory) -> Path:
+    """The shaky clip with a start timecode: a tmcd track, as cameras write."""
+    out = tmp_path_factory.mktemp("timecode") / "tc.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(shaky), "-map", "0:v", "-c", "copy"]
+    subprocess.run([*cmd, "-timecode", TIMECODE, str(out)], check=True)
+    assert [(s.tag, s.timecode) for s in probe(out).streams if s.kind == "data"] == [
+        ("tmcd", TIMECODE)
+    ]
+    return out
+
+
+def test_the_timecode_track_is_written_again_in_mp4(timecoded, tmp_path):
+    out = tmp_path / "out.mp4"
+    summary, _ = stabilize_video(timecoded, out, Settings(fov=70.0))
+    assert not summary["notices"]  # not "left out": the muxer writes it from the video's tag
+    tracks = [(s.tag, s.timecode) for s in probe(out).streams if s.kind == "data"]
+    assert tracks == [("tmcd", TIMECODE)]
+
+
+def test_matroska_keeps_the_timecode_as_the_videos_tag_and_says_so(timecoded, tmp_path):
+    out = tmp_path / "out.mkv"
+    summary, _ = stabilize_video(timecoded, out, Settings(fov=70.0))
+    assert [n for n in summary["notices"] if "tmcd" in n] == [
+        f"left out data #1 (tmcd): MATROSKA cannot hold it; its timecode ({TIMECODE}) is kept "
+        "as the video's tag"
+    ]
+    assert probe(out).streams[0].timecode == TIMECODE
+
+
+def test_a_timecode_no_container_holds_is_said_lost(timecoded):
+    mux = keep_streams(probe(timecoded), container_for("out.avi"))
+    assert [n for n in mux.notices if "tmcd" in n] == [
+        f"left out data #1 (tmcd): AVI cannot hold it; its timecode ({TIMECODE}) is lost"
+    ]
