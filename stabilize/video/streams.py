@@ -33,7 +33,7 @@ def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0
     kept: list[int] = []
     timecode = _timecode(info)
     for stream in info.streams:
-        if _rebuilt(stream, info) or (_is_timecode(stream) and container.timecode == "track"):
+        if _rebuilt(stream, info, container):
             continue
         codec, flag = _codec(stream, container)
         where = _name(container)
@@ -73,11 +73,14 @@ def _codec(stream: Stream, container: Container) -> tuple[str | None, str]:
     return ("copy" if held else None), "d"
 
 
-def _rebuilt(stream: Stream, info: VideoInfo) -> bool:
-    """Whether a stream not carried over is in the output anyway: the video itself, or
-    MP4's chapter text track (the chapters are written from the chapter list)."""
+def _rebuilt(stream: Stream, info: VideoInfo, container: Container) -> bool:
+    """Whether a stream not carried over is in the output anyway: the video itself,
+    MP4's chapter text track (the chapters are written from the chapter list), or a
+    timecode track the container writes again from the video's timecode."""
     if stream.kind == "video":
         return stream.index == _first_video(info)
+    if _is_timecode(stream):
+        return container.timecode == "track"
     return stream.kind == "data" and stream.tag == "text" and info.chapters > 0
 
 
