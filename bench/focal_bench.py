@@ -30,19 +30,18 @@ import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 import flow
 from rotation import HoughEstimator, so3
-from rotation.camera import focal_from_fov
-from rotation.focal import estimate_focal
 from stabilize import Settings
 from stabilize.evaluate.metrics import evaluate_pair
-from stabilize.motion.estimate import estimate_rotations
 from stabilize.motion.files import read_rotations
-from stabilize.motion.focal import FOV_BOUNDS, MAX_PAIRS, estimate_motion, initial_focal
+from stabilize.motion.focal import FocalChoice, estimate_motion, focal_from_track
+from stabilize.motion.track import VisualTrack
 from stabilize.synth import SynthOptions, render_clip
 from stabilize.video import probe, read_frames
 
@@ -76,27 +75,21 @@ def phone(work: Path, name: str) -> tuple[Path, float]:
     return phone_clip(clip, view), PHONE_FOCAL * zoom
 
 
-def exact_error(clip: Path, truth: float) -> float:
-    """The search's error (%) on a rendered walk with every kept vector replaced by the
-    flow its true rotation gives at its true focal length: no parallax, no crowd, no flow
-    error, so what is left is the search's own (the same pairs, samples and validity)."""
+def exact_error(clip: Path, track: VisualTrack, focal: FocalChoice, truth: float) -> float:
+    """The search's error (%) on a rendered walk's pass-1 ``track`` (estimated at
+    ``focal``, its samples kept) with every kept vector replaced by the flow its true
+    rotation gives at its true focal length: no parallax, no crowd, no flow error, so what
+    is left is the search's own (the same pairs, samples and validity)."""
     info = probe(clip)
     size = flow.working_size(info.size)
-    start = initial_focal(Settings(), info, None)
-    track = estimate_rotations(clip, info, Settings(focal=start.px), keep_samples=True)
-    estimator = HoughEstimator(size.size, start.px * size.scale[0])
+    estimator = HoughEstimator(size.size, focal.px * size.scale[0])
     x, y, f = estimator.grid.x, estimator.grid.y, truth * size.scale[0]
     rotations = read_rotations(clip.parent / "truth.csv")
-    pairs = min(len(track.rotations), MAX_PAIRS)
-    rays = so3.exp_so3(np.array([rotations[k] for k in range(pairs)])) @ np.stack(
-        [x, y, np.full_like(x, f)]
-    )
+    turns = so3.exp_so3(np.array([rotations[k] for k in range(len(track.rotations))]))
+    rays = turns @ np.stack([x, y, np.full_like(x, f)])
     u, v = f * rays[:, 0] / rays[:, 2] - x, f * rays[:, 1] / rays[:, 2] - y
-    width = info.width * size.scale[0]
-    bounds = tuple(focal_from_fov(fov, width) for fov in FOV_BOUNDS[::-1])
-    rotvecs = so3.log_so3(track.rotations[:pairs])
-    valid = track.samples.valid[:pairs]
-    found = estimate_focal(x, y, u, v, valid, rotvecs, estimator.focal, bounds).focal
+    exact = replace(track, samples=replace(track.samples, u=u, v=v))
+    found = focal_from_track(exact, estimator, info.width * size.scale[0])
     return math.nan if found is None else 100 * (found / f - 1)
 
 
@@ -140,7 +133,9 @@ def main() -> None:
     for name, clip, truth in clips:
         info = probe(clip)
         start = time.perf_counter()
-        _, focal = estimate_motion(clip, info, Settings(flow=args.flow))
+        track, focal = estimate_motion(
+            clip, info, Settings(flow=args.flow), keep_samples=args.exact
+        )
         seconds = time.perf_counter() - start
         error = 100 * (focal.px / truth - 1)
         if focal.source == "estimated" and name.startswith("walk"):
@@ -149,7 +144,7 @@ def main() -> None:
             f"{name:26s}{truth:9.1f}{focal.px:9.1f}{focal.source:>11s}{error:+7.1f}%{seconds:10.2f}"
         )
         if args.exact and name.startswith("walk"):
-            row += f"{exact_error(clip, truth):+11.2f}%"
+            row += f"{exact_error(clip, track, focal, truth):+11.2f}%"
         if args.shake and name.startswith("walk"):
             fov = math.degrees(2 * math.atan(info.width / 2 / truth))
             flows = ["--flow", args.flow]
