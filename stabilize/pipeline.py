@@ -102,6 +102,11 @@ def stabilize_video(
         track.times, R, track.support, K, job.info.size, settings, rolling, job.lens, residual
     )
     t_plan = time.perf_counter() - start - t_estimate
+    if planned.planner == "bent":
+        tell(
+            "path: no steadiest path within the crop budget was found, so the smoothed one "
+            "was bent towards the shaky one (a higher --max-zoom, or the right --fov, helps)"
+        )
     frames = _write(
         src, dst, job, planned, settings, bar("stabilising", len(track.times)), overwrite
     )
@@ -114,6 +119,7 @@ def stabilize_video(
         "focal_px": float(K[0, 0]),
         "focal": focal.summary(),
         "zoom": float(planned.zoom.max()),
+        "path": planned.planner,  # smoothed, optimal, bent or uncropped (CameraPath)
         "mean_support": float(np.mean(track.support)),
         "repaired_frames": repaired,
         "mean_rotation_deg": float(np.degrees(so3.angle(R)).mean()),

@@ -79,19 +79,21 @@ def plan_path(
 
     path = planned(settings.smooth)
     everything = np.arange(len(O))
+    planner = "smoothed"
     if settings.crop == "none":
-        need = np.ones(len(O))
+        need, planner = np.ones(len(O)), "uncropped"
     elif over(path, everything).any():
         parts = planar.MOTION_MODELS[settings.motion] if measured else ()
         ceiling, sigma = _ceiling(raw, path, parts), settings.smooth / frame_interval(times)
         solved = optimal_path(path, sources, size, parts, CORNERS, ceiling, sigma)
         if solved is not None:
-            path, need = solved, zoom_of(solved, everything)
+            path, need, planner = solved, zoom_of(solved, everything), "optimal"
         else:  # the programme failed: bend, first giving up the slow part of the smoothing
             looser = planned(settings.smooth * LOOSER)
             path, need = respect_zoom_budget(
                 raw, path, times, zoom_of, settings.max_zoom, settings.smooth, (looser,), over
             )
+            planner = "bent"
     else:
         need = zoom_of(path, everything)
     zoom = choose_zoom(need, times, settings.crop, settings.max_zoom, settings.smooth)
@@ -99,7 +101,7 @@ def plan_path(
     H = homography(K, D @ S @ np.swapaxes(O, -1, -2), zoom)  # the middle row's
     by_row = None if rolling is None else corrections(path)
     rows = framing.rows
-    return CameraPath(times, rotations, support, O, S, zoom, H, K, by_row, rows, lens, shift=D)
+    return CameraPath(times, rotations, support, O, S, zoom, H, K, by_row, rows, lens, D, planner)
 
 
 def _ceiling(raw: Trajectory, path: Trajectory, parts: tuple[int, ...]) -> NDArray:

@@ -98,6 +98,18 @@ def test_zoom_limit_is_respected_and_dynamic_crop_has_no_border(shaky, tmp_path)
         assert np.mean(edges.max(axis=1) < 8) < 0.01
 
 
+def test_a_path_bent_within_the_budget_is_said(shaky, tmp_path, monkeypatch):
+    # As when the steadiest-path programme finds no answer (violent shake at a wrong f)
+    monkeypatch.setattr("stabilize.path.plan.optimal_path", lambda *args, **kwargs: None)
+    heard = []
+    summary, planned = stabilize_video(
+        shaky, tmp_path / "bent.mp4", Settings(fov=70.0, max_zoom=1.08), notify=heard.append
+    )
+    assert summary["path"] == planned.planner == "bent"
+    assert any(notice.startswith("path: ") and "--max-zoom" in notice for notice in heard)
+    assert planned.zoom.max() <= 1.08 + 1e-6
+
+
 def test_a_static_clip_comes_out_unchanged(tmp_path):
     clip = render(tmp_path / "static", seed=1, shake_deg=0.0, pan_deg=0.0, walk=0.0, crowd=0)
     out = tmp_path / "out.mp4"

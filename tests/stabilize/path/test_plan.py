@@ -90,3 +90,21 @@ def test_a_long_clip_plans_in_memory_that_grows_with_its_length_not_its_square()
         tracemalloc.stop()
     assert np.all(z >= need) and zoom.max() <= 1.03
     assert peak < 200e6, f"{peak / 1e6:.0f} MB"
+
+
+def test_the_path_says_how_it_was_planned(monkeypatch):
+    t, O = shaky_path(shake_deg=2.0)
+    R = O[1:] @ np.swapaxes(O[:-1], -1, -2)
+
+    def planner(**options):
+        planned = plan_path(t, R, np.ones(len(R)), K, SIZE, Settings(smooth=1.0, **options))
+        return planned.planner, planned
+
+    assert planner(max_zoom=1.1)[0] == "optimal"
+    assert planner(max_zoom=3.0)[0] == "smoothed"  # the smoothed path fits as it is
+    assert planner(crop="none")[0] == "uncropped"
+    monkeypatch.setattr("stabilize.path.plan.optimal_path", lambda *args, **kwargs: None)
+    name, bent = planner(max_zoom=1.1)
+    assert name == "bent" and bent.zoom.max() <= 1.1 + 1e-9
+    C = bent.corrections()
+    assert all(covers(K, c, z + 1e-6, SIZE) for c, z in zip(C, bent.zoom, strict=True))
