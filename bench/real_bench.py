@@ -35,10 +35,13 @@ the median ratio is then given of the means too.
     python bench/real_bench.py --spread        # with the metric's spread on each output
     python bench/real_bench.py clip.mp4 ...    # other clips
     python bench/real_bench.py --width 640     # each clip scaled down first (640×360)
+    python bench/real_bench.py --zoom 2        # each clip's middle half, at its own size
 
 ``--width`` scales every clip down (FFmpeg, bicubic, CRF 14, limited range) before either
 tool sees it: the literature's "Regular" clips are 640×360, and there the lead is
-smaller (README).
+smaller (README). ``--zoom`` keeps the middle 1/Z of each side instead, scaled back to
+the clip's size (or to ``--width``), as a digital zoom does: a narrower field of view
+that no tool is told, where a wrong focal length shows most.
 """
 
 from __future__ import annotations
@@ -103,9 +106,12 @@ def main() -> None:
     parser.add_argument("--fov", help="passed to our run (e.g. auto)")
     parser.add_argument("--spread", action="store_true", help="read each output mirrored too")
     parser.add_argument("--width", type=int, help="scale each clip down to this width first")
+    parser.add_argument("--zoom", type=float, help="keep each clip's middle 1/ZOOM first")
     args = parser.parse_args()
     if args.width is not None and args.width < 16:
         parser.error("--width must be at least 16 px")
+    if args.zoom is not None and not 1 <= args.zoom <= 8:
+        parser.error("--zoom must be between 1 and 8")
     work = Path(tempfile.mkdtemp(prefix="real-bench-"))
     ratios, mean_ratios = [], []
     header = (
@@ -116,11 +122,9 @@ def main() -> None:
     for given in args.clips or clips(work):
         name = f"{given.parent.name}/{given.name}"[-27:]
         tag = f"{given.parent.name}_{given.stem}"  # the rendered walks are all clip.mp4
-        clip = (
-            given
-            if args.width is None
-            else scaled(given, work / f"{tag}_w{args.width}.mp4", args.width)
-        )
+        clip = given
+        if args.width is not None or args.zoom is not None:
+            clip = viewed(given, work / f"{tag}_view.mp4", args.width, args.zoom or 1.0)
         info = probe(clip)
         mine, theirs = work / f"{tag}_ours.mp4", work / f"{tag}_vidstab.mp4"
         cmd = [sys.executable, "-m", "stabilize.cli", "run", str(clip), str(mine), "-q"]
@@ -157,12 +161,16 @@ def main() -> None:
         )
 
 
-def scaled(clip: Path, dst: Path, width: int) -> Path:
-    """``clip``'s video scaled to ``width`` (its aspect kept, even sides), at ``dst``;
-    a clip no wider is taken as it is."""
-    if probe(clip).width <= width:
+def viewed(clip: Path, dst: Path, width: int | None, zoom: float) -> Path:
+    """``clip``'s video at ``dst``: its middle 1/``zoom`` of each side, scaled to
+    ``width`` (its aspect kept, even sides; None: its own width, never up from there)."""
+    info = probe(clip)
+    out = min(width or info.width, info.width)
+    if zoom == 1.0 and out == info.width:
         return clip
-    view = f"scale={width}:-2:flags=bicubic"
+    cw, ch = 2 * round(info.width / zoom / 2), 2 * round(info.height / zoom / 2)
+    crop = f"crop={cw}:{ch}:{(info.width - cw) // 2}:{(info.height - ch) // 2},"
+    view = f"{crop if zoom != 1.0 else ''}scale={out}:-2:flags=bicubic"
     cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-map", "0:v:0", "-vf", view]
     codec = ["-c:v", "libx264", "-crf", "14", "-pix_fmt", "yuv420p", "-an"]
     subprocess.run([*cmd, *codec, str(dst)], check=True)
