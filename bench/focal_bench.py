@@ -46,10 +46,9 @@ from stabilize.synth import SynthOptions, render_clip
 from stabilize.video import probe, read_frames
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from real_bench import PHONE, ZOOM_CROP, mirrored, phone_clip, span
+from real_bench import PHONE, WALK, ZOOM_CROP, mirrored, phone_clip, span
 
 PHONE_FOCAL = 573.85  # px at 640×480, its calibration
-WALK = 1.4  # m/s
 # (FFmpeg filter, zoom): its frames' middle about the principal point (406.01, 309.01),
 # shown at 640×480
 ZOOMS = {

@@ -66,6 +66,7 @@ SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
 REAL = ("handheld/cockatoo.mp4", "gopro/karma.mp4", "gopro/hero7.mp4", "gopro/max-heromode.mp4")
 JUMP_PX = 2.0  # a frame's high-passed zoom beyond this is a jump between depth layers
 RENDERED_FOV = (30.0, 45.0, 100.0)  # walks past near walls, at these unknown fields of view
+WALK = 1.4  # m/s, the rendered walks' pace
 # phone-cc9 zoomed in, as a phone's digital zoom does: its frames' middle 320×240 about the
 # principal point (406.01, 309.01), shown at 640×480: a real 31° clip whose f is known
 # (2 × 573.85 px), the kind of narrow clip (a zoo, a stage) where a wrong f shows most
@@ -95,7 +96,7 @@ def clips(work: Path) -> list[Path]:
 
     for fov in RENDERED_FOV:
         folder = work / f"walk{int(fov)}"
-        render_clip(folder, SynthOptions(seed=int(fov), seconds=4.0, hfov=fov, walk=1.4))
+        render_clip(folder, SynthOptions(seed=int(fov), seconds=4.0, hfov=fov, walk=WALK))
         found.append(folder / "clip.mp4")
     return found
 
@@ -168,21 +169,25 @@ def viewed(clip: Path, dst: Path, width: int | None, zoom: float) -> Path:
     out = min(width or info.width, info.width)
     if zoom == 1.0 and out == info.width:
         return clip
-    cw, ch = 2 * round(info.width / zoom / 2), 2 * round(info.height / zoom / 2)
-    crop = f"crop={cw}:{ch}:{(info.width - cw) // 2}:{(info.height - ch) // 2},"
-    view = f"{crop if zoom != 1.0 else ''}scale={out}:-2:flags=bicubic"
+    crop = f"{middle(info.width, info.height, 1 / zoom)}," if zoom != 1.0 else ""
+    view = f"{crop}scale={out}:-2:flags=bicubic"
     cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-map", "0:v:0", "-vf", view]
     codec = ["-c:v", "libx264", "-crf", "14", "-pix_fmt", "yuv420p", "-an"]
     subprocess.run([*cmd, *codec, str(dst)], check=True)
     return dst
 
 
+def middle(width: int, height: int, ratio: float) -> str:
+    """FFmpeg's crop filter for the middle ``ratio`` of each side of a frame (even sides)."""
+    cw, ch = 2 * round(width * ratio / 2), 2 * round(height * ratio / 2)
+    return f"crop={cw}:{ch}:{(width - cw) // 2}:{(height - ch) // 2}"
+
+
 def crop_only(clip: Path, dst: Path, ratio: float, size: tuple[int, int]) -> Path:
     """``clip``'s middle, ``ratio`` of each side, scaled back to ``size`` (h, w) with the
     bench's encoder: the crop without the stabilisation."""
     h, w = size
-    cw, ch = 2 * round(w * ratio / 2), 2 * round(h * ratio / 2)
-    view = f"crop={cw}:{ch}:{(w - cw) // 2}:{(h - ch) // 2},scale={w}:{h}:flags=bicubic"
+    view = f"{middle(w, h, ratio)},scale={w}:{h}:flags=bicubic"
     cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-vf", view, *ENCODER, "-an"]
     subprocess.run([*cmd, str(dst)], check=True)
     return dst
