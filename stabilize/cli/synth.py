@@ -43,6 +43,8 @@ def synth(
     shake_deg: float = typer.Option(1.0, min=0.0, help="RMS hand shake per axis (1–9 Hz), deg."),
     pan_deg: float = typer.Option(10.0, help="Intentional pan over the clip, deg."),
     walk: float = typer.Option(1.0, min=0.0, help="Walking speed, m/s."),
+    bob_m: float = typer.Option(0.02, min=0.0, help="Walking's vertical bob (amplitude), m."),
+    sway_m: float = typer.Option(0.015, min=0.0, help="Walking's lateral sway (amplitude), m."),
     rolling_shutter_ms: float = typer.Option(0.0, min=0.0, help="Sensor readout time, ms."),
     gyro_offset: float = typer.Option(0.35, help="Gyro clock minus video clock, s."),
     background: Path | None = typer.Option(
@@ -73,6 +75,8 @@ def synth(
         shake_deg=shake_deg,
         pan_deg=pan_deg,
         walk=walk,
+        bob_m=bob_m,
+        sway_m=sway_m,
         rolling_shutter_ms=rolling_shutter_ms,
         gyro_offset=gyro_offset,
         background=str(bg) if bg else None,

@@ -57,6 +57,8 @@ class SynthOptions:
     shake_deg: float = 1.0
     pan_deg: float = 10.0
     walk: float = 1.0
+    bob_m: float = 0.02  # a walker's vertical bob and lateral sway (amplitudes, m): only
+    sway_m: float = 0.015  # while walking; 0 and 0 make a dolly's steady translation
     rolling_shutter_ms: float = 0.0
     gyro_offset: float = 0.35  # gyro clock minus video clock, seconds
     gyro_rate: float = 400.0
@@ -85,8 +87,8 @@ class SynthOptions:
             self.shake_deg,
             self.pan_deg,
             self.walk,
-            bob_m=0.02 * walking,
-            sway_m=0.015 * walking,
+            bob_m=self.bob_m * walking,
+            sway_m=self.sway_m * walking,
         )
 
     def K(self) -> NDArray[np.float64]:

@@ -10,8 +10,8 @@ from stabilize.video import probe, read_frames
 
 def test_synth_command_writes_clip_truth_and_gyro(tmp_path):
     out = tmp_path / "clip"
-    result = CliRunner().invoke(app, ["synth", str(out), "--seconds", "0.5", "--size",
-                                      "320x180", "--procedural", "-q"])  # fmt: skip
+    args = ["--seconds", "0.5", "--size", "320x180", "--procedural", "--bob-m", "0.03", "-q"]
+    result = CliRunner().invoke(app, ["synth", str(out), *args])
     assert result.exit_code == 0, result.output
     summary = json.loads(result.output)
     assert summary["frames"] == 15
@@ -26,6 +26,8 @@ def test_synth_command_writes_clip_truth_and_gyro(tmp_path):
     assert len(gyro_line) == 4 and gyro_line[3].isdigit()
     stamps = [int(v) for v in (out / "timestamps.csv").read_text().split()]
     assert len(stamps) == 15 and stamps[0] == 350_000_000  # the 0.35 s default offset
+    meta = json.loads((out / "truth.json").read_text())
+    assert meta["bob_m"] == 0.03 and meta["sway_m"] == 0.015
     assert not list(out.glob(".*partial*"))  # no temporary files left behind
 
 

@@ -49,3 +49,15 @@ def test_rolling_shutter_bends_the_frame():
                                               **SMALL))))[0]  # fmt: skip
     assert np.array_equal(gs[0], rs[0])  # the first row is read at the frame time
     assert not np.array_equal(gs[-1], rs[-1])
+
+
+def test_a_steady_walk_only_moves_forward():
+    steady = SynthOptions(walk=1.4, shake_deg=0.0, pan_deg=0.0, bob_m=0.0, sway_m=0.0, **SMALL)
+    t = np.arange(steady.n_frames) / steady.fps
+    centre = trajectory.position(steady.motion, t)
+    assert np.allclose(centre[:, :2], 0.0)
+    assert np.allclose(np.diff(centre[:, 2]), 1.4 / steady.fps)
+    assert np.allclose(truth_rotations(steady), np.eye(3))
+    walk = trajectory.position(SynthOptions(walk=1.4, **SMALL).motion, t)
+    assert np.abs(walk[:, 1]).max() > 0.01  # the default walk bobs (0.02 m)
+    assert np.abs(walk[:, 0]).max() > 0.005  # and sways (0.015 m)
