@@ -29,8 +29,8 @@ alone spends the crop budget.
 
 Clips are solved in windows of ``WINDOW`` frames that overlap by ``OVERLAP``, the first
 frames of each held to the previous window's answer, so time and memory grow linearly
-with the clip's length; a window the target fits, with nothing carried into it, is not
-solved at all.
+with the clip's length. Every window is solved, those the target fits too: a smoother
+leaves shake that the crop could hold (:func:`stabilize.path.plan.plan_path`).
 """
 
 from __future__ import annotations
@@ -143,10 +143,7 @@ def _solve_window(
     x[fixed:] = 0.0
     h, w = size
     lo, hi = np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5])
-    on_target = _outside(sources(part, frames), lo, hi)  # (n, M)
-    if not x.any() and not on_target.any():
-        return x  # the target fits and nothing carries over: no programme to solve
-    active = np.zeros(on_target.shape, bool)
+    active = np.zeros(sources(part, frames).shape[:2], bool)  # (n, M) border points
     active[fixed:, corners] = True  # the held frames were checked in the last window
     margin = np.full(len(frames), MARGIN_PX)
     cost = _shake_cost(unrolled(part, parts), sigma)  # the same in every round

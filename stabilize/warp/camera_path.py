@@ -43,9 +43,10 @@ class CameraPath:
     # (N, 3, 3) the 2-D correction D_t after the rotation (normalised coordinates; the
     # homographies and the row corrections include it)
     shift: NDArray | None = None
-    # How the path was planned (stabilize.path.plan): "smoothed" (it fits the budget as
-    # smoothed), "optimal" (the steadiest path within it), "bent" (that programme found
-    # no answer, and the smoothed path was bent towards the raw one) or "uncropped"
+    # How the path was planned (stabilize.path.plan): "optimal" (the steadiest path within
+    # the crop), "smoothed" (kept as smoothed: held by --lock, or within the budget where
+    # that programme found no answer), "bent" (over the budget where it found none, so
+    # bent towards the raw one) or "uncropped"
     planner: str = "smoothed"
 
     def corrections(self, frames: int | slice | NDArray = slice(None)) -> NDArray:

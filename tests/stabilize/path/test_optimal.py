@@ -89,10 +89,19 @@ def test_the_shake_operator_sees_no_shake_in_a_steady_move_and_all_of_a_jolt():
     assert abs(high[29, 1] - 0.01) < 0.002 and np.abs(high[:, [0, 2]]).max() < 1e-12
 
 
-def test_where_the_budget_is_not_reached_the_path_is_the_smoothed_one():
+def test_where_the_smoothed_path_fits_the_path_is_steadier_within_the_same_crop():
     t, O = shaky_path(n=120, shake_deg=0.3, seed=2)
     planned = plan_path(t, _rotations(O), np.ones(119), K, SIZE, Settings(max_zoom=1.3))
-    assert np.allclose(planned.smooth, smooth_orientations(planned.raw, t, 0.5))
+    framing = Framing(K, SIZE)
+    S = smooth_orientations(O, t, 0.5)
+    need = framing.required_zooms(S @ np.swapaxes(O, -1, -2), 1.3 * 1.001)
+    assert need.max() < 1.3  # the smoothed path fits the budget
+    assert planned.zoom.max() <= need.max() + 1e-9  # and no more crop is spent than it spends
+    assert framing.covered(planned.corrections(), planned.zoom + 1e-6).all()
+    H = shake_operator(len(O), 3, 15.0)
+    shake = [np.linalg.norm(H @ unrolled(Trajectory(p, np.zeros((120, 4))), ()).ravel())
+             for p in (planned.smooth, S)]  # fmt: skip
+    assert shake[0] < 0.5 * shake[1]
 
 
 def test_long_clips_are_solved_in_windows_that_join_smoothly():

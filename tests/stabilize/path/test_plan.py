@@ -101,9 +101,11 @@ def test_the_path_says_how_it_was_planned(monkeypatch):
         return planned.planner, planned
 
     assert planner(max_zoom=1.1)[0] == "optimal"
-    assert planner(max_zoom=3.0)[0] == "smoothed"  # the smoothed path fits as it is
+    assert planner(max_zoom=3.0)[0] == "optimal"  # the smoothed path fits: made steadier
+    assert planner(max_zoom=3.0, method="lock")[0] == "smoothed"  # held: kept as it is
     assert planner(crop="none")[0] == "uncropped"
     monkeypatch.setattr("stabilize.path.plan.optimal_path", lambda *args, **kwargs: None)
+    assert planner(max_zoom=3.0)[0] == "smoothed"  # it fits, and the programme failed
     name, bent = planner(max_zoom=1.1)
     assert name == "bent" and bent.zoom.max() <= 1.1 + 1e-9
     C = bent.corrections()
