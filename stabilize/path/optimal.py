@@ -143,18 +143,20 @@ def _solve_window(
     x[fixed:] = 0.0
     h, w = size
     lo, hi = np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5])
-    active = np.zeros(sources(part, frames).shape[:2], bool)  # (n, M) border points
+    src = sources(deviate(part, x, parts), frames)  # (n, M, 2) at δ = x
+    active = np.zeros(src.shape[:2], bool)
     active[fixed:, corners] = True  # the held frames were checked in the last window
     margin = np.full(len(frames), MARGIN_PX)
     cost = _shake_cost(unrolled(part, parts), sigma)  # the same in every round
     for _ in range(ROUNDS):
-        src, jac = _linearised(sources, part, frames, x, parts)
+        jac = _jacobian(sources, part, frames, x, parts, src)
         crop = _crop_rows(src, jac, x, active, margin, lo, hi)
         solved = _programme(crop, x, fixed, ceiling, cost)
         if solved is None:
             return None
         x = solved
-        out = _outside(sources(deviate(part, x, parts), frames), lo, hi)
+        src = sources(deviate(part, x, parts), frames)  # the check, and the next round's
+        out = _outside(src, lo, hi)
         out[:fixed] = False
         if not out.any():
             return x
@@ -170,17 +172,21 @@ def _outside(src: NDArray, lo: NDArray, hi: NDArray) -> NDArray[np.bool_]:
     return ~inside | ~np.isfinite(src).all(axis=2)
 
 
-def _linearised(
-    sources: Sources, part: Trajectory, frames: NDArray, x: NDArray, parts: tuple[int, ...]
-) -> tuple[NDArray, NDArray]:
-    """The border sources (n, M, 2) at δ = x and their Jacobian (n, M, 2, k)."""
-    here = sources(deviate(part, x, parts), frames)
+def _jacobian(
+    sources: Sources,
+    part: Trajectory,
+    frames: NDArray,
+    x: NDArray,
+    parts: tuple[int, ...],
+    here: NDArray,
+) -> NDArray:
+    """The Jacobian (n, M, 2, k) of the border sources at δ = x, ``here`` (n, M, 2)."""
     jac = np.empty((*here.shape, x.shape[1]))
     for j in range(x.shape[1]):
         step = x.copy()
         step[:, j] += STEP
         jac[..., j] = (sources(deviate(part, step, parts), frames) - here) / STEP
-    return here, jac
+    return jac
 
 
 def _crop_rows(
