@@ -22,6 +22,7 @@ stabilised: a run on a shaking walk is not expected to read much under its outpu
 from __future__ import annotations
 
 import argparse
+import sys
 import tempfile
 from dataclasses import replace
 from pathlib import Path
@@ -32,12 +33,13 @@ from stabilize.path.residual import MOTION_MODELS
 from stabilize.synth import SynthOptions, render_clip
 from stabilize.video import probe, read_frames
 
-WALK = 1.4  # m/s, as real_bench's walks
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from real_bench import walk_options
 
 
 def variants(fov: float) -> dict[str, SynthOptions]:
     """The walk at ``fov`` as real_bench renders it, and with parts of its motion off."""
-    walk = SynthOptions(seed=int(fov), seconds=4.0, hfov=fov, walk=WALK)
+    walk = walk_options(fov)
     return {
         "walk": walk,
         "hand shake alone": replace(walk, bob_m=0.0, sway_m=0.0),

@@ -52,6 +52,7 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -61,6 +62,9 @@ from stabilize_bench import ENCODER, timed, vidstab
 from stabilize.evaluate.metrics import evaluate, evaluate_pair
 from stabilize.evaluate.plot import plot_shake
 from stabilize.video import ffmpeg_exe, probe, read_frames
+
+if TYPE_CHECKING:
+    from stabilize.synth import SynthOptions
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
 REAL = ("handheld/cockatoo.mp4", "gopro/karma.mp4", "gopro/hero7.mp4", "gopro/max-heromode.mp4")
@@ -92,13 +96,21 @@ def clips(work: Path) -> list[Path]:
     if PHONE.is_dir():
         found.append(phone_clip(work / "phone-cc9.mp4"))
         found.append(phone_clip(work / "phone-cc9-zoom31.mp4", ZOOM_CROP))
-    from stabilize.synth import SynthOptions, render_clip
+    from stabilize.synth import render_clip
 
     for fov in RENDERED_FOV:
         folder = work / f"walk{int(fov)}"
-        render_clip(folder, SynthOptions(seed=int(fov), seconds=4.0, hfov=fov, walk=WALK))
+        render_clip(folder, walk_options(fov))
         found.append(folder / "clip.mp4")
     return found
+
+
+def walk_options(fov: float) -> SynthOptions:
+    """The rendered walk past near walls at ``fov`` (SynthOptions: 540×960, 4 s, at
+    ``WALK`` m/s, seeded by its field of view)."""
+    from stabilize.synth import SynthOptions
+
+    return SynthOptions(seed=int(fov), seconds=4.0, hfov=fov, walk=WALK)
 
 
 def main() -> None:
