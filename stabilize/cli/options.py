@@ -147,6 +147,7 @@ MaxStretchOption = Annotated[
         max=100.0,
         help="The most the rolling-shutter correction may shear or stretch a frame, %; "
         "a frame whose rows turned further is corrected less (ramped over 0.15 s). "
+        "The path's keystone at the frame's middle is kept within it too, apart. "
         "100: no limit.",
     ),
 ]

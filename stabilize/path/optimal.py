@@ -12,6 +12,8 @@ its 2-D components), the path is the one whose velocity keeps the least shake,
 
     minimise   ½ ‖(I - G_σ) Δp‖² + ½ η ‖δ‖²
     subject to every output border point of every frame mapping inside the input,
+               and every frame's warp stretching the output's middle no more than
+               ``floor`` allows,
 
 where Δp is the frame-to-frame velocity, G_σ a Gaussian low-pass of σ = ``--smooth``
 (in frames), so (I - G_σ) Δp is the part of the velocity a viewer sees as shake (the
@@ -26,6 +28,14 @@ the answer until the exact check passes (a few rounds). Only the output's corner
 constrained at first (for a homography they are enough); border points found outside
 are added in later rounds. The 2-D correction may never zoom in (``ceiling``): the zoom
 alone spends the crop budget.
+
+The stretch is σ_min/σ_max of the warp's Jacobian at the output's middle
+(:meth:`stabilize.warp.coverage.Framing.middle_jacobian`), held at least ``floor``
+(1 - ``--max-stretch``): the keystone of a turn about an axis in the image plane, which
+the distortion metric reads. Where the focal length is too short (the 69° default on a
+view zoomed in) a turn explains a shift with too much of it: on karma's middle third
+the path lagged the drone's last turn by 13.7° at 621 px, the 2-D path holding the
+middle still, and the last frames read 0.974 (vid.stab 0.997); within the bound, 0.990.
 
 Clips are solved in windows of ``WINDOW`` frames that overlap by ``OVERLAP``, the first
 frames of each held to the previous window's answer, so time and memory grow linearly
@@ -70,6 +80,14 @@ BROKEN = 1e-7
 # sources(part, frames): the input pixels (n, M, 2) of the output border's M points at
 # max_zoom for the given frames, of a path whose part at those frames is ``part``.
 Sources = Callable[[Trajectory, NDArray], NDArray]
+# middle(part, frames): the Jacobian (n, 2, 2) of those frames' warps at the output's
+# middle (stabilize.warp.coverage.Framing.middle_jacobian).
+Middle = Callable[[Trajectory, NDArray], NDArray]
+# The disc |s| ≤ r that bounds the stretch (_stretch_rows) is held by the polygon of
+# SIDES sides inside it; its rows are scaled so that one within a half of r of binding
+# counts as near (NEAR), so that a frame far from its bound adds no rows to a solve.
+SIDES = 8
+STRETCH_SLACK = 1e-4  # how far under the floor an answer's stretch may read
 
 
 def unrolled(target: Trajectory, parts: tuple[int, ...]) -> NDArray[np.float64]:
@@ -97,11 +115,15 @@ def optimal_path(
     corners: NDArray,
     ceiling: NDArray | None = None,
     sigma: float = 15.0,
+    middle: Middle | None = None,
+    floor: float = 0.0,
 ) -> Trajectory | None:
     """The steadiest path in the sense above whose every frame covers the output; None
     where the programme fails (the caller falls back). ``corners``: the indices, among
     the border points ``sources`` gives, of the output's corners; ``ceiling`` (n, k):
-    upper bounds on δ (+inf for none); ``sigma``: the low-pass's σ, in frames."""
+    upper bounds on δ (+inf for none); ``sigma``: the low-pass's σ, in frames;
+    ``middle``, ``floor``: each frame's σ_min/σ_max at the output's middle is held at
+    least ``floor`` (none for 0 or without ``middle``)."""
     n = len(target.turn)
     k = 3 + len(parts)
     delta = np.zeros((n, k))
@@ -111,9 +133,26 @@ def optimal_path(
         stop = min(n, start + WINDOW)
         fixed = FIXED if start > 0 else 0
         frames = np.arange(start, stop)
-        found = _solve_window(
-            target, sources, size, parts, corners, frames, delta, fixed, ceiling[frames], sigma
+        # without the stretch bound where no path keeps to it and to the crop
+        bounds = [(middle, floor)] if middle is not None and floor > 0 else []
+        bounds.append((None, 0.0))
+        attempts = (
+            _solve_window(
+                target,
+                sources,
+                size,
+                parts,
+                corners,
+                frames,
+                delta,
+                fixed,
+                ceiling[frames],
+                sigma,
+                bound,
+            )
+            for bound in bounds
         )
+        found = next((answer for answer in attempts if answer is not None), None)
         if found is None:
             return None
         keep = stop if stop == n else stop - OVERLAP + FIXED
@@ -135,9 +174,10 @@ def _solve_window(
     fixed: int,
     ceiling: NDArray,
     sigma: float,
+    stretch: tuple[Middle | None, float],
 ) -> NDArray | None:
     """δ (n, k) for one window of ``frames``, its first ``fixed`` rows held, at most
-    ``ceiling``."""
+    ``ceiling``, within the ``stretch`` (middle, floor) of :func:`optimal_path`."""
     part = target.take(frames)
     x = delta[frames].copy()
     x[fixed:] = 0.0
@@ -148,21 +188,49 @@ def _solve_window(
     active[fixed:, corners] = True  # the held frames were checked in the last window
     margin = np.full(len(frames), MARGIN_PX)
     cost = _shake_cost(unrolled(part, parts), sigma)  # the same in every round
+    middle, floor = stretch
+    bounded = middle is not None and floor > 0
+    tight = np.ones(len(frames))  # the stretch bound's share, where the linearisation was off
+    answer = None  # the last answer that covers the output
     for _ in range(ROUNDS):
         jac = _jacobian(sources, part, frames, x, parts, src)
         crop = _crop_rows(src, jac, x, active, margin, lo, hi)
-        solved = _programme(crop, x, fixed, ceiling, cost)
+        tries = [crop]
+        if bounded:
+            # The bound as asked, else no frame stretched further than at x (a path far
+            # over it, linearised, can leave no answer)
+            conf, rest, grad = _stretch_linearised(middle, part, frames, x, parts)
+            radius = np.linalg.norm(conf, axis=1) * (1 - floor) / (1 + floor) * tight
+            grown = np.maximum(radius, np.linalg.norm(rest, axis=1) / np.cos(np.pi / SIDES))
+            tries = [
+                _stacked(crop, _stretch_rows(rest, grad, x, r, fixed)) for r in (radius, grown)
+            ]
+        attempts = (_programme(rows, x, fixed, ceiling, cost) for rows in tries)
+        solved = next((found for found in attempts if found is not None), None)
         if solved is None:
-            return None
+            return answer
         x = solved
         src = sources(deviate(part, x, parts), frames)  # the check, and the next round's
         out = _outside(src, lo, hi)
         out[:fixed] = False
+        short = np.zeros(len(frames), bool)
+        if bounded:
+            short = _ratio(middle(deviate(part, x, parts), frames)) < floor - STRETCH_SLACK
+            short[:fixed] = False
         if not out.any():
-            return x
+            answer = x
+            if not short.any():
+                return x
         margin[out.any(axis=1)] += 0.5  # the linearisation was off there: further inside
         active |= out
-    return None
+        tight[short] *= 0.8
+    return answer
+
+
+def _ratio(J: NDArray) -> NDArray[np.float64]:
+    """σ_min/σ_max of 2×2 matrices J (n, 2, 2) (:func:`conformal_split`)."""
+    conf, rest = (np.linalg.norm(v, axis=-1) for v in conformal_split(J))
+    return (conf - rest) / (conf + rest)
 
 
 def _outside(src: NDArray, lo: NDArray, hi: NDArray) -> NDArray[np.bool_]:
@@ -180,13 +248,22 @@ def _jacobian(
     parts: tuple[int, ...],
     here: NDArray,
 ) -> NDArray:
-    """The Jacobian (n, M, 2, k) of the border sources at δ = x, ``here`` (n, M, 2)."""
+    """The Jacobian (n, ..., k) at δ = x of a per-frame figure (the border sources
+    (n, M, 2), the stretch), ``here`` (n, ...) at x."""
     jac = np.empty((*here.shape, x.shape[1]))
     for j in range(x.shape[1]):
         step = x.copy()
         step[:, j] += STEP
         jac[..., j] = (sources(deviate(part, step, parts), frames) - here) / STEP
     return jac
+
+
+def conformal_split(J: NDArray) -> tuple[NDArray, NDArray]:
+    """(c, s) (..., 2) of 2×2 matrices J = [[a, b], [e, d]]: c = ((a + d)/2, (e - b)/2),
+    the scaled rotation nearest J, and s = ((a - d)/2, (b + e)/2), the rest. J's singular
+    values are |c| ± |s|, so σ_min/σ_max = (|c| - |s|)/(|c| + |s|)."""
+    a, b, e, d = J[..., 0, 0], J[..., 0, 1], J[..., 1, 0], J[..., 1, 1]
+    return np.stack([a + d, e - b], -1) / 2, np.stack([a - d, b + e], -1) / 2
 
 
 def _crop_rows(
@@ -212,6 +289,43 @@ def _crop_rows(
         blocks += [A, -A]
         rhs += [hi[axis] - margin[f] - base, base - (lo[axis] + margin[f])]
     return sparse.vstack(blocks).tocsr(), np.concatenate(rhs)
+
+
+def _stretch_linearised(
+    middle: Middle, part: Trajectory, frames: NDArray, x0: NDArray, parts: tuple[int, ...]
+) -> tuple[NDArray, NDArray, NDArray]:
+    """(c, s, G) at δ = x0: the parts (n, 2) of each frame's Jacobian at the output's
+    middle (:func:`conformal_split`), and the Jacobian (n, 2, k) of s in δ."""
+    conf, rest = conformal_split(middle(deviate(part, x0, parts), frames))
+    grad = _jacobian(lambda p, f: conformal_split(middle(p, f))[1], part, frames, x0, parts, rest)
+    return conf, rest, grad
+
+
+def _stretch_rows(
+    rest: NDArray, grad: NDArray, x0: NDArray, radius: NDArray, fixed: int
+) -> tuple[sparse.csr_array, NDArray]:
+    """(A, b) of |s| ≤ r (``radius``, n) linearised around x0, for every frame after the
+    ``fixed`` ones: u_m · (s + G (δ - x0)) ≤ r cos(π/SIDES) for the SIDES directions u_m
+    (:func:`_stretch_linearised`). With r = |c| (1 - floor)/(1 + floor), σ_min/σ_max ≥
+    floor (:func:`conformal_split`)."""
+    n, k = x0.shape
+    angle = 2 * np.pi * np.arange(SIDES) / SIDES
+    u = np.stack([np.cos(angle), np.sin(angle)], 1)  # (SIDES, 2)
+    f = np.repeat(np.arange(fixed, n), SIDES)
+    m = np.tile(np.arange(SIDES), n - fixed)
+    # slack within r/2 reads as NEAR (and with no stretch allowed, within 1e-4 / 2)
+    scale = (NEAR / (0.5 * np.maximum(radius, STRETCH_SLACK)))[f]
+    G = np.einsum("cj,cjk->ck", u[m], grad[f]) * scale[:, None]  # (c, k)
+    b = (radius[f] * np.cos(np.pi / SIDES) - np.einsum("cj,cj->c", u[m], rest[f])) * scale
+    b += np.einsum("ck,ck->c", G, x0[f])
+    rows = np.repeat(np.arange(len(f)), k)
+    cols = (f[:, None] * k + np.arange(k)).ravel()
+    return sparse.csr_array((G.ravel(), (rows, cols)), shape=(len(f), n * k)), b
+
+
+def _stacked(*systems: tuple[sparse.csr_array, NDArray]) -> tuple[sparse.csr_array, NDArray]:
+    """The rows of several systems (A, b) of A δ ≤ b, as one."""
+    return sparse.vstack([A for A, _ in systems]).tocsr(), np.concatenate([b for _, b in systems])
 
 
 def shake_operator(n: int, k: int, sigma: float) -> sparse.csr_array:

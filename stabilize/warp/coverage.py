@@ -18,6 +18,7 @@ from stabilize.warp.lens import Lens
 from stabilize.warp.sources import homography_sources, lens_sources
 
 BORDER_SAMPLES = 16  # points per edge checked for coverage
+MIDDLE_STEP_PX = 4.0  # half the span of the differences that give the warp's Jacobian
 ZOOM_STEPS = 16  # bisection steps of the zoom search
 # The output's corners among the border points (the ends of the top and bottom edges).
 CORNERS = np.array([0, BORDER_SAMPLES - 1, BORDER_SAMPLES, 2 * BORDER_SAMPLES - 1])
@@ -53,9 +54,26 @@ class Framing:
 
     def border_sources(self, C: NDArray, zoom: NDArray) -> NDArray[np.float64]:
         """Input pixels (N, M, 2) of the output border's M points, for N frames at once."""
+        return self.sources(C, zoom, _border(self.size))
+
+    def middle_jacobian(self, C: NDArray, zoom: NDArray) -> NDArray[np.float64]:
+        """The Jacobian (N, 2, 2) of each frame's map from output to input pixels at the
+        output's middle (central differences, ``MIDDLE_STEP_PX`` either side).
+
+        Its σ_min/σ_max is the stretch a registration of the output against its original
+        reads as distortion there. A turn by θ about an axis in the image plane alone
+        foreshortens the frame by cos θ across that axis; a 2-D shift after it, back by
+        f tan θ, keeps that; a rolling shutter's correction adds its shear and stretch."""
+        h, w = self.size
+        mid, d = np.array([(w - 1) / 2, (h - 1) / 2]), MIDDLE_STEP_PX
+        pts = mid + np.array([[d, 0.0], [-d, 0.0], [0.0, d], [0.0, -d]])
+        src = self.sources(C, zoom, pts)
+        return np.stack([src[:, 0] - src[:, 1], src[:, 2] - src[:, 3]], axis=-1) / (2 * d)
+
+    def sources(self, C: NDArray, zoom: NDArray, pts: NDArray) -> NDArray[np.float64]:
+        """Input pixels (N, M, 2) of output pixels ``pts`` (M, 2), for N frames at once."""
         C = np.asarray(C, dtype=np.float64)
         zoom = np.asarray(zoom, dtype=np.float64)
-        pts = _border(self.size)
         if self.lens is not None:
             return lens_sources(self.lens, C, zoom, pts, self.rows)
         Z = zoomed(self.K, zoom)

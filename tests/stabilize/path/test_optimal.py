@@ -13,6 +13,7 @@ from stabilize.path.optimal import (
     NEAR,
     _programme,
     _shake_cost,
+    conformal_split,
     optimal_path,
     shake_operator,
     unrolled,
@@ -135,3 +136,38 @@ def test_the_programme_reaches_the_optimum_of_a_bounded_least_squares(scale):
     found = _programme(crop, np.zeros((n, k)), 0, np.full((n, k), np.inf), _shake_cost(p0, 15.0))
     # Clarabel's tolerances on the rad² objective as it was (1e-7) stopped 1.7% of c off
     assert np.abs(found.ravel() - exact).max() < 1e-3 * c
+
+
+def test_the_conformal_split_gives_the_singular_values():
+    J = np.random.default_rng(0).normal(size=(50, 2, 2))
+    conf, rest = (np.linalg.norm(v, axis=-1) for v in conformal_split(J))
+    s = np.linalg.svd(J, compute_uv=False)
+    np.testing.assert_allclose(s[:, 0], conf + rest)
+    np.testing.assert_allclose(s[:, 1], np.abs(conf - rest))
+
+
+@pytest.mark.parametrize("max_stretch", [100.0, 0.8])
+def test_no_frame_is_stretched_beyond_max_stretch(max_stretch):
+    """A pan at the clip's end, 1.5° a frame, that the 2-D path undoes (a focal length
+    too short makes a turn of a shift, and the image motion it leaves undoes it): the
+    smoothed paths lag it, and the turn they leave keystones the last frames."""
+    n = 120
+    t = np.arange(n) / 30.0
+    step = np.zeros(n - 1)
+    step[-25:] = np.radians(1.5)
+    rotations = so3.exp_so3(np.c_[np.zeros(n - 1), step, np.zeros(n - 1)])
+    residual = np.zeros((n - 1, 4))
+    residual[:, 0] = -np.tan(step)
+    settings = Settings(max_stretch=max_stretch, motion="translation")
+    planned = plan_path(t, rotations, np.ones(n - 1), K, SIZE, settings, residual=residual)
+    framing = Framing(K, SIZE)
+    assert planned.planner == "optimal"
+    assert framing.covered(planned.corrections(), planned.zoom + 1e-6).all()
+    s = np.linalg.svd(
+        framing.middle_jacobian(planned.corrections(), planned.zoom), compute_uv=False
+    )
+    least = (s[:, 1] / s[:, 0]).min()
+    if max_stretch == 100.0:
+        assert least < 0.985  # unbounded, the keystone reads 0.983
+    else:
+        assert least >= 0.992 - 1e-4

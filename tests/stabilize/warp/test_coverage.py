@@ -36,3 +36,22 @@ def test_the_vectorised_zoom_search_finds_the_least_covering_zoom():
             assert covers(K, c, z, (180, 320)) and not covers(K, c, z - 1e-4, (180, 320))
             checked += 1
     assert checked >= 5
+
+
+def test_the_middle_jacobian_is_the_zoom_and_a_turns_foreshortening():
+    theta = 0.2
+    turn = so3.exp_so3([0.0, theta, 0.0])
+    J = Framing(K, SIZE).middle_jacobian(np.stack([np.eye(3), turn]), np.array([1.25, 1.0]))
+    np.testing.assert_allclose(J[0], np.eye(2) / 1.25, atol=1e-9)  # output → input
+    s = np.linalg.svd(J[1], compute_uv=False)
+    # across the turn's axis the frame is foreshortened by cos θ: a keystone
+    np.testing.assert_allclose(s[1] / s[0], np.cos(theta), atol=1e-5)
+    # a 2-D shift after the turn moves where its foreshortening is read: back by f tan θ
+    # (the middle's source the input's middle) it stays cos θ, the other way it grows
+    back = np.array([[1.0, 0.0, -np.tan(theta)], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    further = np.linalg.inv(back)
+    J = Framing(K, SIZE).middle_jacobian(np.stack([back @ turn, further @ turn]), np.ones(2))
+    s = np.linalg.svd(J, compute_uv=False)
+    np.testing.assert_allclose(
+        s[:, 1] / s[:, 0], [np.cos(theta), np.cos(2 * theta) / np.cos(theta)], atol=1e-4
+    )
