@@ -46,6 +46,7 @@ leaves shake that the crop could hold (:func:`stabilize.path.plan.plan_path`).
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import partial
 
 import numpy as np
 from numpy.typing import NDArray
@@ -88,6 +89,7 @@ Middle = Callable[[Trajectory, NDArray], NDArray]
 # counts as near (NEAR), so that a frame far from its bound adds no rows to a solve.
 SIDES = 8
 STRETCH_SLACK = 1e-4  # how far under the floor an answer's stretch may read
+SHORTER = (0.5, 0.25, 0.125)  # the shares of a step tried where it broke more frames
 
 
 def unrolled(target: Trajectory, parts: tuple[int, ...]) -> NDArray[np.float64]:
@@ -192,6 +194,8 @@ def _solve_window(
     bounded = middle is not None and floor > 0
     tight = np.ones(len(frames))  # the stretch bound's share, where the linearisation was off
     answer = None  # the last answer that covers the output
+    broken = None  # how many frames the last answer left uncovered
+    check = partial(_checked, sources, part, frames, parts, lo, hi, fixed)
     for _ in range(ROUNDS):
         jac = _jacobian(sources, part, frames, x, parts, src)
         crop = _crop_rows(src, jac, x, active, margin, lo, hi)
@@ -209,10 +213,18 @@ def _solve_window(
         solved = next((found for found in attempts if found is not None), None)
         if solved is None:
             return answer
-        x = solved
-        src = sources(deviate(part, x, parts), frames)  # the check, and the next round's
-        out = _outside(src, lo, hi)
-        out[:fixed] = False
+        previous, x = x, solved
+        src, out = check(x)  # the check, and the next round's linearisation point
+        if broken is not None and out.any(axis=1).sum() > broken:
+            # More frames broke than last round: the step went beyond where the rows
+            # hold, so a shorter one (cockatoo's middle half: 3 frames out, then 17,
+            # 19, 24 in six rounds, and the path was bent; with it the window is solved)
+            for share in SHORTER:
+                step = previous + share * (solved - previous)
+                step_src, step_out = check(step)
+                if step_out.any(axis=1).sum() < out.any(axis=1).sum():
+                    x, src, out = step, step_src, step_out
+        broken = out.any(axis=1).sum()
         short = np.zeros(len(frames), bool)
         if bounded:
             short = _ratio(middle(deviate(part, x, parts), frames)) < floor - STRETCH_SLACK
@@ -231,6 +243,24 @@ def _ratio(J: NDArray) -> NDArray[np.float64]:
     """σ_min/σ_max of 2×2 matrices J (n, 2, 2) (:func:`conformal_split`)."""
     conf, rest = (np.linalg.norm(v, axis=-1) for v in conformal_split(J))
     return (conf - rest) / (conf + rest)
+
+
+def _checked(
+    sources: Sources,
+    part: Trajectory,
+    frames: NDArray,
+    parts: tuple[int, ...],
+    lo: NDArray,
+    hi: NDArray,
+    fixed: int,
+    x: NDArray,
+) -> tuple[NDArray, NDArray]:
+    """(the border sources, which of them lie outside, the held frames' not counted)
+    of the window's path at δ = x."""
+    src = sources(deviate(part, x, parts), frames)
+    out = _outside(src, lo, hi)
+    out[:fixed] = False
+    return src, out
 
 
 def _outside(src: NDArray, lo: NDArray, hi: NDArray) -> NDArray[np.bool_]:

@@ -171,3 +171,18 @@ def test_no_frame_is_stretched_beyond_max_stretch(max_stretch):
         assert least < 0.985  # unbounded, the keystone reads 0.983
     else:
         assert least >= 0.992 - 1e-4
+
+
+def test_violent_shake_at_a_short_focal_length_is_planned_not_bent():
+    """6° of shake at 300 px across 640 (a wide view, or a too short f): steps of the
+    linearised programme overshoot, and without shorter ones where a round breaks more
+    frames than the last (and the stretch bound that keeps the turns in hand) the rounds
+    ran out and the path was bent."""
+    K_short = intrinsics(300.0, SIZE)
+    t, O = shaky_path(n=150, shake_deg=6.0, seed=0)
+    rng = np.random.default_rng(0)
+    residual = np.c_[rng.normal(0, 0.02, (149, 2)), rng.normal(0, 0.01, (149, 2))]
+    settings = Settings(max_zoom=1.15, motion="similarity")
+    planned = plan_path(t, _rotations(O), np.ones(149), K_short, SIZE, settings, residual=residual)
+    assert planned.planner == "optimal"
+    assert Framing(K_short, SIZE).covered(planned.corrections(), planned.zoom + 1e-6).all()
