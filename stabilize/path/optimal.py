@@ -138,22 +138,8 @@ def optimal_path(
         # without the stretch bound where no path keeps to it and to the crop
         bounds = [(middle, floor)] if middle is not None and floor > 0 else []
         bounds.append((None, 0.0))
-        attempts = (
-            _solve_window(
-                target,
-                sources,
-                size,
-                parts,
-                corners,
-                frames,
-                delta,
-                fixed,
-                ceiling[frames],
-                sigma,
-                bound,
-            )
-            for bound in bounds
-        )
+        window = (target, sources, size, parts, corners, frames, delta, fixed)
+        attempts = (_solve_window(*window, ceiling[frames], sigma, bound) for bound in bounds)
         found = next((answer for answer in attempts if answer is not None), None)
         if found is None:
             return None
@@ -185,7 +171,8 @@ def _solve_window(
     x[fixed:] = 0.0
     h, w = size
     lo, hi = np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5])
-    src = sources(deviate(part, x, parts), frames)  # (n, M, 2) at δ = x
+    check = partial(_checked, sources, part, frames, parts, lo, hi, fixed)
+    src, _ = check(x)  # (n, M, 2) at δ = x
     active = np.zeros(src.shape[:2], bool)
     active[fixed:, corners] = True  # the held frames were checked in the last window
     margin = np.full(len(frames), MARGIN_PX)
@@ -195,7 +182,9 @@ def _solve_window(
     tight = np.ones(len(frames))  # the stretch bound's share, where the linearisation was off
     answer = None  # the last answer that covers the output
     broken = None  # how many frames the last answer left uncovered
-    check = partial(_checked, sources, part, frames, parts, lo, hi, fixed)
+    # the warps' Jacobians at the output's middle at δ = x: the check, and the next
+    # round's linearisation point
+    here = middle(deviate(part, x, parts), frames) if bounded else None
     for _ in range(ROUNDS):
         jac = _jacobian(sources, part, frames, x, parts, src)
         crop = _crop_rows(src, jac, x, active, margin, lo, hi)
@@ -203,7 +192,7 @@ def _solve_window(
         if bounded:
             # The bound as asked, else no frame stretched further than at x (a path far
             # over it, linearised, can leave no answer)
-            conf, rest, grad = _stretch_linearised(middle, part, frames, x, parts)
+            conf, rest, grad = _stretch_linearised(middle, part, frames, x, parts, here)
             radius = np.linalg.norm(conf, axis=1) * (1 - floor) / (1 + floor) * tight
             grown = np.maximum(radius, np.linalg.norm(rest, axis=1) / np.cos(np.pi / SIDES))
             tries = [
@@ -227,7 +216,8 @@ def _solve_window(
         broken = out.any(axis=1).sum()
         short = np.zeros(len(frames), bool)
         if bounded:
-            short = _ratio(middle(deviate(part, x, parts), frames)) < floor - STRETCH_SLACK
+            here = middle(deviate(part, x, parts), frames)
+            short = _ratio(here) < floor - STRETCH_SLACK
             short[:fixed] = False
         if not out.any():
             answer = x
@@ -322,11 +312,17 @@ def _crop_rows(
 
 
 def _stretch_linearised(
-    middle: Middle, part: Trajectory, frames: NDArray, x0: NDArray, parts: tuple[int, ...]
+    middle: Middle,
+    part: Trajectory,
+    frames: NDArray,
+    x0: NDArray,
+    parts: tuple[int, ...],
+    here: NDArray,
 ) -> tuple[NDArray, NDArray, NDArray]:
     """(c, s, G) at δ = x0: the parts (n, 2) of each frame's Jacobian at the output's
-    middle (:func:`conformal_split`), and the Jacobian (n, 2, k) of s in δ."""
-    conf, rest = conformal_split(middle(deviate(part, x0, parts), frames))
+    middle there, ``here`` (n, 2, 2) (:func:`conformal_split`), and the Jacobian
+    (n, 2, k) of s in δ."""
+    conf, rest = conformal_split(here)
     grad = _jacobian(lambda p, f: conformal_split(middle(p, f))[1], part, frames, x0, parts, rest)
     return conf, rest, grad
 

@@ -129,10 +129,10 @@ def plan_path(
             if solved is not None:
                 path, need, planner = solved, zoom_of(solved, everything), "optimal"
     zoom = choose_zoom(need, times, settings.crop, settings.max_zoom, settings.smooth)
-    S, D = path.turn, planar.corrections(raw.shift, path.shift)
-    H = homography(K, D @ S @ np.swapaxes(O, -1, -2), zoom)  # the middle row's
+    D, C = turns(path, everything)
+    H = homography(K, D @ C, zoom)  # the middle row's
     by_row = None if rolling is None else corrections(path)
-    rows = framing.rows
+    rows, S = framing.rows, path.turn
     return CameraPath(times, rotations, support, O, S, zoom, H, K, by_row, rows, lens, D, planner)
 
 
