@@ -10,7 +10,8 @@ squared residual and σ² its value per degree of freedom.
 
 Smooth, slow motion shows every band the same turn whatever r is; the estimate is then
 refused. An estimate that cannot be told from 0 is a global shutter, and nothing is
-corrected.
+corrected. A sensor's readout is one figure, so one that the clip's two halves read
+apart (:func:`halves_disagree`) is refused too: the fit followed something else.
 """
 
 from __future__ import annotations
@@ -32,6 +33,14 @@ MIN_PAIRS = 20  # pairs with three usable bands, fewest that date the rows
 MAX_STDERR = 0.06  # of a frame interval (2 ms at 30 fps): a less certain readout is refused
 SIGNIFICANT = 3.0  # an estimate within this many σ of 0, or under MIN_READOUT, is 0
 MIN_READOUT = 0.001  # s
+LONGEST, SHORTEST = 1.05, -0.1  # frame intervals: readouts outside these are impossible
+# The halves of the searched pairs must agree (halves_disagree). Measured, the halves'
+# readouts (ms) and how many σ apart: phone-cc9 24.7 and 32.3, 2.4 σ (its gyro: 25.4),
+# zoomed in to 31° 12.3 and 11.6; karma at 640 px 23.4 and 34.5, 5.2 σ; cockatoo at
+# 640 px 12.8 and 4.5, 4.7 σ (3.1 at full size: a global shutter); karma's middle half
+# and third 6.7 and 26.2, 8.7 and 21.9.
+SPLIT_SIGMAS = 3.0
+SPLIT_RATIO = 2.0
 
 
 @dataclass(frozen=True)
@@ -93,16 +102,44 @@ def estimate_readout(track: VisualTrack) -> tuple[Readout, Spline | None]:
     """The readout of a track with band rotations, and the attitude fitted at it (None
     where refused or 0). A long clip's readout is searched on its ``MAX_SEARCH_PAIRS``
     most shaking consecutive pairs (the search's time grows with the length: 1.5 s for a
-    minute), and the attitude is then fitted to the whole clip once."""
+    minute), and the attitude is then fitted to the whole clip once. A readout found is
+    searched again on each half of those pairs, and refused where they disagree
+    (:func:`halves_disagree`)."""
     frame = frame_interval(track.times)
     first = _most_shaking(track, MAX_SEARCH_PAIRS)
     searched = track.pairs(first, first + MAX_SEARCH_PAIRS) if first is not None else track
-    bands = Bands.of(searched)
-    per_pair = bands.usable.reshape(len(searched.bands), -1).sum(0)
-    if int((per_pair >= 3).sum()) < MIN_PAIRS:
+    found = _search(searched, frame)
+    if found is None:
         reason = "too few frames with texture across their height"
         return Readout(0.0, "refused", reason=reason), None
-    knots = knots_for(searched.times)
+    r, stderr, bands, knots, scale = found
+    if first is not None:  # the attitude of the whole clip
+        bands, knots = Bands.of(track), knots_for(track.times)
+        scale = cauchy_scale(bands, r, knots)
+    readout, spline = decide(bands, r, stderr, frame, knots, scale)
+    if readout.seconds > 0:
+        half = len(searched.rotations) // 2
+        halves = [_search(searched.pairs(a, b), frame) for a, b in ((0, half), (half, 2 * half))]
+        # a half that reads an impossible readout measured none, and contradicts nothing
+        if all(h is not None and _possible(h[0], frame) for h in halves):
+            (r1, s1, *_), (r2, s2, *_) = halves
+            if halves_disagree(r1, s1, r2, s2):
+                reason = (
+                    f"the clip's halves disagree ({1000 * r1:.1f} ± {1000 * s1:.1f} and "
+                    f"{1000 * r2:.1f} ± {1000 * s2:.1f} ms): not the sensor's"
+                )
+                return Readout(0.0, "refused", r, stderr, reason), None
+    return readout, spline
+
+
+def _search(track: VisualTrack, frame: float) -> tuple[float, float, Bands, NDArray, float] | None:
+    """(r, σ_r, and the bands, knots and Cauchy scale it was searched with) over a
+    track's pairs; None where too few of them have three usable bands."""
+    bands = Bands.of(track)
+    per_pair = bands.usable.reshape(len(track.bands), -1).sum(0)
+    if int((per_pair >= 3).sum()) < MIN_PAIRS:
+        return None
+    knots = knots_for(track.times)
     scale = cauchy_scale(bands, 0.5 * frame, knots)
 
     def cost(r: float) -> float:
@@ -114,10 +151,23 @@ def estimate_readout(track: VisualTrack) -> tuple[Readout, Spline | None]:
     step = grid[1] - grid[0]
     r = golden_section(cost, grid[max(best - 1, 0)], grid[min(best + 1, GRID - 1)], 1e-2 * step)
     stderr = curvature_stderr(bands, r, knots, scale, 0.05 * frame)
-    if first is not None:  # the attitude of the whole clip
-        bands, knots = Bands.of(track), knots_for(track.times)
-        scale = cauchy_scale(bands, r, knots)
-    return decide(bands, r, stderr, frame, knots, scale)
+    return r, stderr, bands, knots, scale
+
+
+def _possible(r: float, frame: float) -> bool:
+    """Whether a readout r (s) is one a sensor of that frame interval can have."""
+    return SHORTEST * frame < r < LONGEST * frame
+
+
+def halves_disagree(r1: float, s1: float, r2: float, s2: float) -> bool:
+    """Whether two halves' readouts (s, with σ) differ by more than ``SPLIT_SIGMAS`` σ
+    and by more than a factor of ``SPLIT_RATIO``: a sensor's readout is one figure, so a
+    fit whose halves read such different ones follows something else (a subject, a
+    drone's vibration). Either alone is not enough: σ, from the fit's curvature, is
+    optimistic (rendered errors of 0.4–1.9 ms against 0.1), and small readouts differ by
+    large factors within their noise."""
+    apart = abs(r1 - r2) > SPLIT_SIGMAS * np.hypot(s1, s2)
+    return bool(apart and min(r1, r2) < max(r1, r2) / SPLIT_RATIO)
 
 
 def _most_shaking(track: VisualTrack, n: int) -> int | None:
@@ -141,9 +191,9 @@ def decide(
     """Refuse an uncertain or impossible readout, call a negligible one 0."""
     if not stderr <= MAX_STDERR * frame:
         return Readout(0.0, "refused", r, stderr, "the motion does not pin it down"), None
-    if r >= 1.05 * frame:
+    if r >= LONGEST * frame:
         return Readout(0.0, "refused", r, stderr, "longer than a frame interval"), None
-    if r <= -0.1 * frame:
+    if r <= SHORTEST * frame:
         reason = "negative: a bottom-to-top readout is not modelled"
         return Readout(0.0, "refused", r, stderr, reason), None
     if r < max(SIGNIFICANT * stderr, MIN_READOUT):

@@ -11,6 +11,7 @@ from stabilize.path.budget import Trajectory, respect_zoom_budget
 from stabilize.path.optimal import (
     HOLD,
     NEAR,
+    TRUST,
     _programme,
     _shake_cost,
     conformal_split,
@@ -136,6 +137,20 @@ def test_the_programme_reaches_the_optimum_of_a_bounded_least_squares(scale):
     found = _programme(crop, np.zeros((n, k)), 0, np.full((n, k), np.inf), _shake_cost(p0, 15.0))
     # Clarabel's tolerances on the rad² objective as it was (1e-7) stopped 1.7% of c off
     assert np.abs(found.ravel() - exact).max() < 1e-3 * c
+
+
+def test_a_round_steps_no_further_than_the_linearisation_is_trusted():
+    """A programme whose rows leave its optimum 5 rad away (a direction the linearised
+    corners barely see) steps only TRUST towards it; one within reach is solved whole."""
+    n, k = 4, 2
+    cost = (sparse.eye_array(n * k, format="csc"), np.full(n * k, -5.0))  # optimum δ = 5
+    no_rows = (sparse.csr_array((0, n * k)), np.zeros(0))
+    ceiling = np.full((n, k), np.inf)
+    found = _programme(no_rows, np.zeros((n, k)), 1, ceiling, cost)
+    assert np.allclose(found[0], 0.0)  # the held frame
+    assert np.allclose(found[1:], TRUST, atol=1e-6)
+    near = (sparse.eye_array(n * k, format="csc"), np.full(n * k, -0.5 * TRUST))
+    assert np.allclose(_programme(no_rows, np.zeros((n, k)), 0, ceiling, near), 0.5 * TRUST)
 
 
 def test_the_conformal_split_gives_the_singular_values():

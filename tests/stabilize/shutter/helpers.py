@@ -17,7 +17,7 @@ def between(motion: Handheld, a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def banded_track(
-    readout: float,
+    readout: float | np.ndarray,
     shake_deg: float = 3.0,
     seconds: float = 3.0,
     bands: int = 6,
@@ -25,7 +25,8 @@ def banded_track(
     seed: int = 0,
 ) -> tuple[VisualTrack, Handheld]:
     """A track whose band b of pair k turned from t_k + r·y_b to t_{k+1} + r·y_b, with
-    ``noise_deg`` of measurement noise per axis; the whole frame's seen at y = ½."""
+    ``noise_deg`` of measurement noise per axis; the whole frame's seen at y = ½.
+    ``readout``: r, or one per pair."""
     motion = Handheld(seconds, seed, shake_deg, pan_deg=10.0, walk=0.0)
     rng = np.random.default_rng(seed)
     times = np.arange(int(seconds * FPS) + 1) / FPS

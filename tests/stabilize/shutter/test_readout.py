@@ -34,6 +34,19 @@ def test_smooth_slow_motion_is_refused():
     assert "pin" in found.reason
 
 
+def test_a_readout_the_clips_halves_disagree_on_is_refused():
+    # No sensor reads out in 8 ms for half a clip and 30 ms for the other: a fit that
+    # finds that follows something else (a subject, a drone's vibration).
+    pairs = 90
+    readout = np.where(np.arange(pairs) < pairs // 2, 0.008, 0.030)
+    track, _ = banded_track(readout, seed=7)
+    found, spline = estimate_readout(track)
+    assert found.source == "refused" and found.seconds == 0.0 and spline is None
+    assert "halves disagree" in found.reason and found.estimate > 0.008
+    steady, _ = banded_track(np.full(pairs, 0.030), seed=7)
+    assert estimate_readout(steady)[0].seconds == pytest.approx(0.030, abs=1e-3)
+
+
 def test_too_few_textured_bands_are_refused():
     track, _ = banded_track(0.025, seed=5)
     bare = replace(track, band_support=np.zeros_like(track.band_support))
