@@ -45,6 +45,12 @@ def test_a_readout_the_clips_halves_disagree_on_is_refused():
     assert "halves disagree" in found.reason and found.estimate > 0.008
     steady, _ = banded_track(np.full(pairs, 0.030), seed=7)
     assert estimate_readout(steady)[0].seconds == pytest.approx(0.030, abs=1e-3)
+    # A half that reads longer than a frame (45 ms at 30 fps: it comes out at the
+    # search's 40 ms end) measured no readout, and contradicts none: the 15 ms half
+    # stands, and the whole clip's estimate is kept.
+    track, _ = banded_track(np.where(np.arange(pairs) < pairs // 2, 0.045, 0.015), seed=7)
+    found, spline = estimate_readout(track)
+    assert found.source == "estimated" and found.seconds > 0.010 and spline is not None
 
 
 def test_too_few_textured_bands_are_refused():
