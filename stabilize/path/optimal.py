@@ -90,11 +90,11 @@ Middle = Callable[[Trajectory, NDArray], NDArray]
 SIDES = 8
 STRETCH_SLACK = 1e-4  # how far under the floor an answer's stretch may read
 SHORTER = (0.5, 0.25, 0.125)  # the shares of a step tried where it broke more frames
-# The longest step a round takes in any component (rad, normalised units). The real
-# views' rounds step at most 0.56; on max-heromode's middle third without its readout a
-# round stepped 0.76 to a path over the stretch bound (σ ratio 0.845), the next 1,400
-# along a direction the linearised corners barely see, and its end read 3.48 px at
-# distortion 0.843 (within the trust, 1.66 px and 0.993; at 0.5, 1.77 px)
+# The longest step a round takes in any component (rad, normalised units). The rounds
+# measured on the real views step at most 0.59; on max-heromode's middle third without
+# its readout a round stepped 0.76 to a path over the stretch bound (σ ratio 0.845), the
+# next 1,400 along a direction the linearised corners barely see, and its end read
+# 3.48 px at distortion 0.843 (within the trust, 1.66 px and 0.993; at 0.5, 1.77 px)
 TRUST = 1.0
 
 
