@@ -96,6 +96,11 @@ SHORTER = (0.5, 0.25, 0.125)  # the shares of a step tried where it broke more f
 # next 1,400 along a direction the linearised corners barely see, and its end read
 # 3.48 px at distortion 0.843 (within the trust, 1.66 px and 0.993; at 0.5, 1.77 px)
 TRUST = 1.0
+# The least shake the objective's unit is (rad² a frame and component: 0.0003 px of
+# high-passed velocity at 600 px). A held target (--lock) has none (2.7e-37 on
+# phone-cc9, against 3.9e-11 to 2.5e-8 for the smoothed targets of the bench), and P
+# scaled by it (1.9e34) left Clarabel no answer: every held path was bent
+STILL = 1e-13
 
 
 def unrolled(target: Trajectory, parts: tuple[int, ...]) -> NDArray[np.float64]:
@@ -375,7 +380,8 @@ def _shake_cost(p0: NDArray, sigma: float) -> tuple[sparse.csc_array, NDArray] |
     """(P, q) of the objective ½ δᵀP δ + qᵀδ = (½ ‖(I - G_σ) Δ(p0 + δ)‖² + ½ η ‖δ‖²) / c₀
     + const for the target's unrolled path p0 (n, k); None for fewer than 3 frames.
 
-    c₀ = ½ ‖(I - G_σ) Δp0‖², the target's own shake, is the unit. In rad² the objective
+    c₀ = ½ ‖(I - G_σ) Δp0‖², the target's own shake, is the unit (at least ``STILL`` a
+    frame and component: a held target has none). In rad² the objective
     is about 1e-7, where Clarabel's absolute tolerances (1e-8) end the solve early: on
     karma 0.03–0.1% above the optimum, the path up to 0.4 px off it. P is given as its
     upper triangle, the form Clarabel takes, made once for every solve of the window.
@@ -385,7 +391,7 @@ def _shake_cost(p0: NDArray, sigma: float) -> tuple[sparse.csc_array, NDArray] |
         return None
     H = shake_operator(n, k, sigma)
     shake = H @ p0.ravel()
-    unit = 0.5 * float(shake @ shake) or 1.0
+    unit = max(0.5 * float(shake @ shake), STILL * n * k)
     P = (H.T @ H + HOLD * sparse.eye_array(n * k)) / unit
     return sparse.triu(P).tocsc(), H.T @ shake / unit
 

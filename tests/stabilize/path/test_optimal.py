@@ -153,6 +153,21 @@ def test_a_round_steps_no_further_than_the_linearisation_is_trusted():
     assert np.allclose(_programme(no_rows, np.zeros((n, k)), 0, ceiling, near), 0.5 * TRUST)
 
 
+def test_a_held_target_is_solved():
+    """A held target (--lock) has no shake of its own but its rounding (1e-37 rad² on
+    phone-cc9): scaled by that, P was 1e34 and Clarabel found no answer, so every held
+    path that did not fit was bent. Frames 40–59 must turn 0.01 rad away from it."""
+    n, k = 120, 3
+    p0 = np.full((n, k), 0.3) + np.random.default_rng(0).normal(0, 1e-18, (n, k))
+    need = np.zeros(n * k)
+    need[40 * k : 60 * k] = 1e-2
+    crop = (-sparse.eye_array(n * k, format="csr"), -need)
+    cost = _shake_cost(p0, 15.0)
+    found = _programme(crop, np.zeros((n, k)), 0, np.full((n, k), np.inf), cost)
+    assert found is not None and (found[40:60] >= 1e-2 - 1e-9).all()
+    assert abs(cost[0]).max() < 1e12
+
+
 def test_the_conformal_split_gives_the_singular_values():
     J = np.random.default_rng(0).normal(size=(50, 2, 2))
     conf, rest = (np.linalg.norm(v, axis=-1) for v in conformal_split(J))

@@ -103,6 +103,10 @@ def test_the_path_says_how_it_was_planned(monkeypatch):
     assert planner(max_zoom=1.1)[0] == "optimal"
     assert planner(max_zoom=3.0)[0] == "optimal"  # the smoothed path fits: made steadier
     assert planner(max_zoom=3.0, method="lock")[0] == "smoothed"  # held: kept as it is
+    name, held = planner(max_zoom=1.1, method="lock")  # held, and does not fit
+    assert name == "optimal"
+    C = held.corrections()
+    assert all(covers(K, c, z + 1e-6, SIZE) for c, z in zip(C, held.zoom, strict=True))
     assert planner(crop="none")[0] == "uncropped"
     monkeypatch.setattr("stabilize.path.plan.optimal_path", lambda *args, **kwargs: None)
     assert planner(max_zoom=3.0)[0] == "smoothed"  # it fits, and the programme failed
