@@ -183,7 +183,7 @@ def _solve_window(
     h, w = size
     lo, hi = np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5])
     check = partial(_checked, sources, part, frames, parts, lo, hi, fixed)
-    src, _ = check(x)  # (n, M, 2) at δ = x
+    src, out = check(x)  # (n, M, 2) at δ = x
     active = np.zeros(src.shape[:2], bool)
     active[fixed:, corners] = True  # the held frames were checked in the last window
     margin = np.full(len(frames), MARGIN_PX)
@@ -191,7 +191,8 @@ def _solve_window(
     middle, floor = stretch
     bounded = middle is not None and floor > 0
     tight = np.ones(len(frames))  # the stretch bound's share, where the linearisation was off
-    answer = None  # the last answer that covers the output
+    # the last answer that covers the output: the start, where it does (a bent path)
+    answer = None if out.any() else x
     broken = None  # how many frames the last answer left uncovered
     # the warps' Jacobians at the output's middle at δ = x: the check, and the next
     # round's linearisation point
