@@ -150,10 +150,20 @@ def optimal_path(
         bounds = [(middle, floor)] if middle is not None and floor > 0 else []
         bounds.append((None, 0.0))
         window = (target, sources, size, parts, corners, frames, delta, fixed)
-        attempts = (_solve_window(*window, ceiling[frames], sigma, bound) for bound in bounds)
-        found = next((answer for answer in attempts if answer is not None), None)
+        for bound in bounds:
+            found = _solve_window(*window, ceiling[frames], sigma, bound)
+            if found is not None:
+                break
         if found is None:
             return None
+        if bound is not bounds[0]:
+            # Solved without the bound: the bound's rounds again, started from that
+            # answer, which covers, so that they keep it or stretch no frame further
+            begun = delta.copy()
+            begun[frames] = found
+            again = (target, sources, size, parts, corners, frames, begun, fixed)
+            kept = _solve_window(*again, ceiling[frames], sigma, bounds[0], from_start=True)
+            found = found if kept is None else kept
         keep = stop if stop == n else stop - OVERLAP + FIXED
         delta[start + fixed : keep] = found[fixed : keep - start]
         if stop == n:
@@ -174,12 +184,15 @@ def _solve_window(
     ceiling: NDArray,
     sigma: float,
     stretch: tuple[Middle | None, float],
+    from_start: bool = False,
 ) -> NDArray | None:
     """δ (n, k) for one window of ``frames``, its first ``fixed`` rows held, at most
-    ``ceiling``, within the ``stretch`` (middle, floor) of :func:`optimal_path`."""
+    ``ceiling``, within the ``stretch`` (middle, floor) of :func:`optimal_path`; started
+    from the target, or with ``from_start`` from ``delta``."""
     part = target.take(frames)
     x = delta[frames].copy()
-    x[fixed:] = 0.0
+    if not from_start:
+        x[fixed:] = 0.0
     h, w = size
     lo, hi = np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5])
     check = partial(_checked, sources, part, frames, parts, lo, hi, fixed)
