@@ -141,14 +141,14 @@ def optimal_path(
     k = 3 + len(parts)
     delta = np.zeros((n, k))
     ceiling = np.full((n, k), np.inf) if ceiling is None else ceiling
+    # without the stretch bound where no path keeps to it and to the crop
+    bounds = [(middle, floor)] if middle is not None and floor > 0 else []
+    bounds.append((None, 0.0))
     start = 0
     while start < n:
         stop = min(n, start + WINDOW)
         fixed = FIXED if start > 0 else 0
         frames = np.arange(start, stop)
-        # without the stretch bound where no path keeps to it and to the crop
-        bounds = [(middle, floor)] if middle is not None and floor > 0 else []
-        bounds.append((None, 0.0))
         window = (target, sources, size, parts, corners, frames, delta, fixed)
         for bound in bounds:
             found = _solve_window(*window, ceiling[frames], sigma, bound)
