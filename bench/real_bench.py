@@ -36,12 +36,15 @@ the median ratio is then given of the means too.
     python bench/real_bench.py clip.mp4 ...    # other clips
     python bench/real_bench.py --width 640     # each clip scaled down first (640×360)
     python bench/real_bench.py --zoom 2        # each clip's middle half, at its own size
+    python bench/real_bench.py --portrait      # each clip's middle 9:16, upright
 
 ``--width`` scales every clip down (FFmpeg, bicubic, CRF 14, limited range) before either
 tool sees it: the literature's "Regular" clips are 640×360, and there the lead is
 smaller (README). ``--zoom`` keeps the middle 1/Z of each side instead, scaled back to
 the clip's size (or to ``--width``), as a digital zoom does: a narrower field of view
-that no tool is told, where a wrong focal length shows most.
+that no tool is told, where a wrong focal length shows most. ``--portrait`` keeps each
+clip's middle 9:16 of its height first: a clip shot with the phone held upright, decoded
+upright, whose default field of view spans its height.
 """
 
 from __future__ import annotations
@@ -120,6 +123,9 @@ def main() -> None:
     parser.add_argument("--spread", action="store_true", help="read each output mirrored too")
     parser.add_argument("--width", type=int, help="scale each clip down to this width first")
     parser.add_argument("--zoom", type=float, help="keep each clip's middle 1/ZOOM first")
+    parser.add_argument(
+        "--portrait", action="store_true", help="keep each clip's middle 9:16 first (upright)"
+    )
     args = parser.parse_args()
     if args.width is not None and args.width < 16:
         parser.error("--width must be at least 16 px")
@@ -136,8 +142,9 @@ def main() -> None:
         name = f"{given.parent.name}/{given.name}"[-27:]
         tag = f"{given.parent.name}_{given.stem}"  # the rendered walks are all clip.mp4
         clip = given
-        if args.width is not None or args.zoom is not None:
-            clip = viewed(given, work / f"{tag}_view.mp4", args.width, args.zoom or 1.0)
+        if args.width is not None or args.zoom is not None or args.portrait:
+            view = work / f"{tag}_view.mp4"
+            clip = viewed(given, view, args.width, args.zoom or 1.0, args.portrait)
         info = probe(clip)
         mine, theirs = work / f"{tag}_ours.mp4", work / f"{tag}_vidstab.mp4"
         cmd = [sys.executable, "-m", "stabilize.cli", "run", str(clip), str(mine), "-q"]
@@ -174,15 +181,21 @@ def main() -> None:
         )
 
 
-def viewed(clip: Path, dst: Path, width: int | None, zoom: float) -> Path:
-    """``clip``'s video at ``dst``: its middle 1/``zoom`` of each side, scaled to
-    ``width`` (its aspect kept, even sides; None: its own width, never up from there)."""
+def viewed(clip: Path, dst: Path, width: int | None, zoom: float, portrait: bool = False) -> Path:
+    """``clip``'s video at ``dst``: with ``portrait`` its middle 9:16 of the frame's
+    height (a phone held upright: decoded upright, its long side is its height), then
+    the middle 1/``zoom`` of each side, scaled to ``width`` (its aspect kept, even sides;
+    None: its own width, never up from there)."""
     info = probe(clip)
-    out = min(width or info.width, info.width)
-    if zoom == 1.0 and out == info.width:
+    w, h = info.width, info.height
+    upright = f"crop={2 * round(h * 9 / 32)}:{h}," if portrait and w > h * 9 / 16 else ""
+    if upright:
+        w = 2 * round(h * 9 / 32)
+    out = min(width or w, w)
+    if zoom == 1.0 and out == w and not upright:
         return clip
-    crop = f"{middle(info.width, info.height, 1 / zoom)}," if zoom != 1.0 else ""
-    view = f"{crop}scale={out}:-2:flags=bicubic"
+    crop = f"{middle(w, h, 1 / zoom)}," if zoom != 1.0 else ""
+    view = f"{upright}{crop}scale={out}:-2:flags=bicubic"
     cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-map", "0:v:0", "-vf", view]
     codec = ["-c:v", "libx264", "-crf", "14", "-pix_fmt", "yuv420p", "-an"]
     subprocess.run([*cmd, *codec, str(dst)], check=True)

@@ -10,8 +10,11 @@ from dataclasses import dataclass, field
 
 from stabilize.video.encode import Encoding
 
-# A phone's main camera is about 26 mm full-frame equivalent: 69° across the long side.
-DEFAULT_HFOV = 69.0
+# A phone's main camera is about 26 mm full-frame equivalent: 69° across the long side,
+# however the phone is held. A portrait clip is decoded upright, so that side is its
+# height: 69° across its width would model a 9:16 clip's camera 1.78× too wide, the
+# costly direction (a wrong f's keystone grows with |1/f'² - 1/f²|)
+DEFAULT_FOV = 69.0
 # Crop at most 13% of each side: about what FFmpeg's vid.stab zooms to (optzoom=1). Where
 # removing all the shake would need more, the path keeps as little of it as a linear
 # programme finds (:mod:`stabilize.path.optimal`).
@@ -69,14 +72,16 @@ class Settings:
     size: tuple[int, int] | None = None  # output (H, W); default: the input's
     encoding: Encoding = field(default_factory=Encoding)
 
-    def focal_px(self, width: int) -> float:
-        """The focal length in pixels for a frame ``width`` pixels wide."""
+    def focal_px(self, size: tuple[int, int]) -> float:
+        """The focal length in pixels for frames of ``size`` (h, w): ``focal``; else
+        ``fov`` across the width; else ``DEFAULT_FOV`` across the long side."""
         if self.focal is not None:
             return float(self.focal)
         from rotation.camera import focal_from_fov  # the estimator's package is heavy
 
-        fov = self.fov if isinstance(self.fov, int | float) else DEFAULT_HFOV
-        return focal_from_fov(fov, width)
+        if isinstance(self.fov, int | float):
+            return focal_from_fov(self.fov, size[1])
+        return focal_from_fov(DEFAULT_FOV, max(size))
 
     @property
     def fov_given(self) -> bool:

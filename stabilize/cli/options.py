@@ -39,8 +39,8 @@ FovOption = Annotated[
     typer.Option(
         help="Horizontal field of view, degrees (1–179). Default (auto): estimated from "
         "the clip's own motion, starting from the file's metadata (a phone's 35 mm "
-        "equivalent) or 69° (a phone's main camera), which stay where the motion does "
-        "not pin it down.",
+        "equivalent) or 69° across the long side (a phone's main camera, held either "
+        "way), which stay where the motion does not pin it down.",
     ),
 ]
 FocalOption = Annotated[

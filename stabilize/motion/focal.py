@@ -115,12 +115,12 @@ def initial_focal(settings: Settings, info: VideoInfo, lens: Lens | None) -> Foc
     width = info.width
     meta = metadata_focal(info)
     if settings.fov_given:
-        return FocalChoice(settings.focal_px(width), width, "given", metadata_px=meta)
+        return FocalChoice(settings.focal_px(info.size), width, "given", metadata_px=meta)
     if lens is not None:
         return FocalChoice(float(lens.K[0, 0]), width, "lens", metadata_px=meta)
     if meta is not None:
         return FocalChoice(meta, width, "metadata", metadata_px=meta)
-    return FocalChoice(settings.focal_px(width), width, "default")
+    return FocalChoice(settings.focal_px(info.size), width, "default")
 
 
 def estimate_motion(

@@ -10,6 +10,7 @@ import pytest
 
 from rotation import so3
 from stabilize import Settings, stabilize_video
+from stabilize.motion.focal import initial_focal
 from stabilize.synth import SynthOptions, trajectory
 from stabilize.video import ffmpeg_exe, frame_times, probe, read_frames
 from tests.stabilize.conftest import render
@@ -138,6 +139,12 @@ def test_portrait_rotation_metadata_is_honoured(shaky, tmp_path):
     subprocess.run(cmd, check=True)
     info = probe(rotated)
     assert info.rotation in (90, 270) and info.size == (320, 180)  # displayed upright
+    # the default field of view spans the long side, however the phone was held
+    upright, level = (
+        initial_focal(Settings(), info, None),
+        initial_focal(Settings(), probe(shaky), None),
+    )
+    assert upright.source == "default" and upright.px == pytest.approx(level.px)
     out = tmp_path / "out.mp4"
     summary, _ = stabilize_video(rotated, out, Settings(fov=50.0))
     result = probe(out)

@@ -67,7 +67,7 @@ def test_bands_voted_from_the_kept_samples_are_those_of_pass_1():
     np.testing.assert_array_equal(whole.rotations, inline.rotations)
     np.testing.assert_array_equal(whole.residual, inline.residual)
     ws = flow.working_size(info.size)
-    focal = settings.focal_px(info.width) * ws.scale[0]
+    focal = settings.focal_px(info.size) * ws.scale[0]
     estimator = estimate.HoughEstimator(ws.size, focal, max_deg=settings.max_deg)
     later = estimate.with_bands(estimator, whole, 6)
     np.testing.assert_allclose(later.bands, inline.bands, atol=1e-12)

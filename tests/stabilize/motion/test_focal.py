@@ -54,7 +54,7 @@ def test_auto_moves_a_wrong_start_towards_the_truth(narrow_walk):
     # the 3% that issue #15 asks (walking parallax biases it long, +14% here), but it
     # must land far closer than where it started.
     track, focal = estimate_motion(narrow_walk, probe(narrow_walk), Settings(fov="auto"))
-    start = Settings().focal_px(320)
+    start = Settings().focal_px((180, 320))
     assert focal.source == "estimated" and track.samples is None
     assert abs(focal.px / NARROW_TRUTH - 1) < abs(start / NARROW_TRUTH - 1) / 3
     assert focal.summary()["fov_deg"] == pytest.approx(focal.fov_deg)
@@ -75,7 +75,7 @@ def test_a_long_clip_is_voted_once_at_the_focal_length_of_its_start(narrow_walk,
     monkeypatch.setattr(focal_module, "focal_from_track", seen)
     info = probe(narrow_walk)
     track, focal = estimate_motion(narrow_walk, info, Settings(), bands=6)
-    start = Settings().focal_px(320)
+    start = Settings().focal_px((180, 320))
     assert searched == [32] and focal.source == "estimated" and track.samples is None
     assert abs(focal.px / NARROW_TRUTH - 1) < abs(start / NARROW_TRUTH - 1) / 3
     given = estimate_rotations(narrow_walk, info, Settings(focal=focal.px), bands=6)
