@@ -37,6 +37,7 @@ the median ratio is then given of the means too.
     python bench/real_bench.py --width 640     # each clip scaled down first (640×360)
     python bench/real_bench.py --zoom 2        # each clip's middle half, at its own size
     python bench/real_bench.py --portrait      # each clip's middle 9:16, upright
+    python bench/real_bench.py --every 2       # every other frame, at half the rate
 
 ``--width`` scales every clip down (FFmpeg, bicubic, CRF 14, limited range) before either
 tool sees it: the literature's "Regular" clips are 640×360, and there the lead is
@@ -44,7 +45,9 @@ smaller (README). ``--zoom`` keeps the middle 1/Z of each side instead, scaled b
 the clip's size (or to ``--width``), as a digital zoom does: a narrower field of view
 that no tool is told, where a wrong focal length shows most. ``--portrait`` keeps each
 clip's middle 9:16 of its height first: a clip shot with the phone held upright, decoded
-upright, whose default field of view spans its height.
+upright, whose default field of view spans its height. ``--every 2`` keeps every other
+frame, at half the rate: twice the motion a pair, as a walk at 15 fps, or past nearer
+surfaces, would show.
 """
 
 from __future__ import annotations
@@ -54,6 +57,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -126,11 +130,15 @@ def main() -> None:
     parser.add_argument(
         "--portrait", action="store_true", help="keep each clip's middle 9:16 first (upright)"
     )
+    parser.add_argument("--every", type=int, default=1, help="keep every EVERY-th frame first")
     args = parser.parse_args()
     if args.width is not None and args.width < 16:
         parser.error("--width must be at least 16 px")
     if args.zoom is not None and not 1 <= args.zoom <= 8:
         parser.error("--zoom must be between 1 and 8")
+    if not 1 <= args.every <= 8:
+        parser.error("--every must be between 1 and 8")
+    view = View(args.width, args.zoom or 1.0, args.portrait, args.every)
     work = Path(tempfile.mkdtemp(prefix="real-bench-"))
     ratios, mean_ratios = [], []
     header = (
@@ -142,9 +150,7 @@ def main() -> None:
         name = f"{given.parent.name}/{given.name}"[-27:]
         tag = f"{given.parent.name}_{given.stem}"  # the rendered walks are all clip.mp4
         clip = given
-        if args.width is not None or args.zoom is not None or args.portrait:
-            view = work / f"{tag}_view.mp4"
-            clip = viewed(given, view, args.width, args.zoom or 1.0, args.portrait)
+        clip = viewed(given, work / f"{tag}_view.mp4", view)
         info = probe(clip)
         mine, theirs = work / f"{tag}_ours.mp4", work / f"{tag}_vidstab.mp4"
         cmd = [sys.executable, "-m", "stabilize.cli", "run", str(clip), str(mine), "-q"]
@@ -181,23 +187,36 @@ def main() -> None:
         )
 
 
-def viewed(clip: Path, dst: Path, width: int | None, zoom: float, portrait: bool = False) -> Path:
-    """``clip``'s video at ``dst``: with ``portrait`` its middle 9:16 of the frame's
-    height (a phone held upright: decoded upright, its long side is its height), then
-    the middle 1/``zoom`` of each side, scaled to ``width`` (its aspect kept, even sides;
-    None: its own width, never up from there)."""
+@dataclass(frozen=True)
+class View:
+    """How the bench sees a clip: with ``portrait`` its middle 9:16 of the frame's height
+    (a phone held upright: decoded upright, its long side is its height), then the middle
+    1/``zoom`` of each side, scaled to ``width`` (its aspect kept, even sides; None: its
+    own width, never up from there), every ``every``-th frame at 1/``every`` the rate."""
+
+    width: int | None = None
+    zoom: float = 1.0
+    portrait: bool = False
+    every: int = 1
+
+
+def viewed(clip: Path, dst: Path, view: View) -> Path:
+    """``clip``'s video as ``view`` sees it, at ``dst`` (``clip`` itself where it sees
+    all of it)."""
     info = probe(clip)
     w, h = info.width, info.height
-    upright = f"crop={2 * round(h * 9 / 32)}:{h}," if portrait and w > h * 9 / 16 else ""
+    upright = f"crop={2 * round(h * 9 / 32)}:{h}," if view.portrait and w > h * 9 / 16 else ""
     if upright:
         w = 2 * round(h * 9 / 32)
-    out = min(width or w, w)
-    if zoom == 1.0 and out == w and not upright:
+    out = min(view.width or w, w)
+    if view == View(width=view.width) and out == w:
         return clip
-    crop = f"{middle(w, h, 1 / zoom)}," if zoom != 1.0 else ""
-    view = f"{upright}{crop}scale={out}:-2:flags=bicubic"
-    cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-map", "0:v:0", "-vf", view]
-    codec = ["-c:v", "libx264", "-crf", "14", "-pix_fmt", "yuv420p", "-an"]
+    crop = f"{middle(w, h, 1 / view.zoom)}," if view.zoom != 1.0 else ""
+    rate = (info.fps or 30.0) / view.every
+    sparse = f"select=not(mod(n\\,{view.every})),setpts=N/({rate}*TB)," if view.every > 1 else ""
+    chain = f"{sparse}{upright}{crop}scale={out}:-2:flags=bicubic"
+    cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-map", "0:v:0", "-vf", chain]
+    codec = ["-r", f"{rate}", "-c:v", "libx264", "-crf", "14", "-pix_fmt", "yuv420p", "-an"]
     subprocess.run([*cmd, *codec, str(dst)], check=True)
     return dst
 
