@@ -88,7 +88,7 @@ def exact_error(clip: Path, track: VisualTrack, focal: FocalChoice, truth: float
     rays = turns @ np.stack([x, y, np.full_like(x, f)])
     u, v = f * rays[:, 0] / rays[:, 2] - x, f * rays[:, 1] / rays[:, 2] - y
     exact = replace(track, samples=replace(track.samples, u=u, v=v))
-    found = focal_from_track(exact, estimator, info.width * size.scale[0])
+    found = focal_from_track(exact, estimator, max(info.size) * size.scale[0])
     return math.nan if found is None else 100 * (found / f - 1)
 
 

@@ -41,7 +41,7 @@ from stabilize.video import VideoInfo
 from stabilize.warp.lens import Lens
 
 FULL_FRAME_DIAGONAL_MM = 43.27
-FOV_BOUNDS = (15.0, 150.0)  # the fields of view searched, degrees across
+FOV_BOUNDS = (15.0, 150.0)  # the fields of view searched, degrees across the long side
 MAX_PAIRS = 120  # consecutive pairs the estimate is made on (the most-turning stretch)
 MIN_TURN_DEG = 0.05  # median pitch/yaw per pair below which f is not pinned down
 DISAGREES = 0.15  # an estimate this far from the metadata's is reported
@@ -143,7 +143,7 @@ def estimate_motion(
     auto = choice.source in ("metadata", "default")  # nothing given: estimated
     ws = flow.working_size(info.size)
     start = HoughEstimator(ws.size, choice.px * ws.scale[0], max_deg=settings.max_deg)
-    width = info.width * ws.scale[0]
+    long_side = max(info.size) * ws.scale[0]  # as the default's 69°, however it is held
     settled: list[FocalChoice] = []
 
     def estimator(resolved: FocalChoice) -> HoughEstimator:
@@ -152,7 +152,7 @@ def estimate_motion(
         return HoughEstimator(ws.size, resolved.px * ws.scale[0], max_deg=settings.max_deg)
 
     def settle(so_far: VisualTrack) -> HoughEstimator | None:
-        found = focal_from_track(so_far, start, width)
+        found = focal_from_track(so_far, start, long_side)
         if found is None:
             return None
         settled.append(_resolved(choice, found / ws.scale[0]))
@@ -172,7 +172,7 @@ def estimate_motion(
     if not auto or settled:  # the samples dropped unless asked for
         return track, settled[0] if settled else choice
     kept = (lambda t: t) if keep_samples else (lambda t: replace(t, samples=None))
-    found = focal_from_track(track, start, width)
+    found = focal_from_track(track, start, long_side)
     if found is None:
         note = f"the clip's motion does not pin the focal length down: {choice.source} kept"
         return kept(with_bands(start, track, bands)), replace(choice, note=note)
@@ -193,9 +193,12 @@ def _resolved(start: FocalChoice, px: float) -> FocalChoice:
     return FocalChoice(px, start.width, "estimated", px, meta, note)
 
 
-def focal_from_track(track: VisualTrack, estimator: HoughEstimator, width: float) -> float | None:
+def focal_from_track(
+    track: VisualTrack, estimator: HoughEstimator, long_side: float
+) -> float | None:
     """The focal length (px at the flow's size) from a track's kept samples, estimated at
-    ``estimator``'s focal length; None where the motion does not pin it down."""
+    ``estimator``'s focal length, searched over ``FOV_BOUNDS`` across the frame's
+    ``long_side`` (px at the flow's size); None where the motion does not pin it down."""
     samples = track.samples
     rotvecs = so3.log_so3(track.rotations)
     turn = np.degrees(np.hypot(rotvecs[:, 0], rotvecs[:, 1]))
@@ -203,7 +206,7 @@ def focal_from_track(track: VisualTrack, estimator: HoughEstimator, width: float
         return None
     first = _most_turning(turn, MAX_PAIRS)
     part = slice(first, first + MAX_PAIRS)
-    bounds = tuple(focal_from_fov(fov, width) for fov in FOV_BOUNDS[::-1])
+    bounds = tuple(focal_from_fov(fov, long_side) for fov in FOV_BOUNDS[::-1])
     grid = estimator.grid
     found = estimate_focal(
         grid.x,

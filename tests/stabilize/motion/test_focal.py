@@ -6,10 +6,12 @@ import math
 import subprocess
 from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+import flow
 import stabilize.motion.focal as focal_module
 from stabilize import Settings
 from stabilize.motion.estimate import estimate_rotations
@@ -105,3 +107,26 @@ def test_a_real_narrow_clip_is_estimated(shared, tmp_path, crop):
     _, focal = estimate_motion(clip, probe(clip), Settings())
     assert focal.source == "estimated"
     assert focal.px == pytest.approx(573.85 * 640 / int(crop.split(":")[0]), rel=0.05)
+
+
+def test_the_search_spans_the_same_fields_of_view_however_the_camera_is_held(
+    shaky, tmp_path, monkeypatch
+):
+    # 15–150° across the long side, as the default's 69°: a portrait clip's telephoto
+    # (23° across its height, 13° across its width) lies inside it, as held level
+    upright = tmp_path / "upright.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-display_rotation", "90", "-i", str(shaky)]
+    subprocess.run([*cmd, "-c", "copy", str(upright)], check=True)
+    searched = []
+
+    def search(*args):
+        searched.append(args[-1])
+        return SimpleNamespace(focal=None)
+
+    monkeypatch.setattr(focal_module, "estimate_focal", search)
+    for clip in (shaky, upright):
+        estimate_motion(clip, probe(clip), Settings())
+    level, held_up = searched[0], searched[-1]
+    assert probe(upright).size == (320, 180) and held_up == pytest.approx(level)
+    width = flow.working_size((180, 320)).size[1]
+    assert level[1] == pytest.approx(width / 2 / math.tan(math.radians(7.5)), rel=1e-3)
