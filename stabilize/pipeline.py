@@ -19,7 +19,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from functools import partial
 from pathlib import Path
 from threading import Thread
@@ -154,6 +154,10 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     check_writable(dst)
     check_encoder(dst, settings.encoding, encoded_size(info, settings))
     lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
+    if info.sideways and readout_given(settings):
+        raise ValueError(
+            f"{src}: {sideways_readout(info)}; give no readout (--rolling-shutter, --readout-ms)"
+        )
     times = frame_times(src, info.input_args)  # read once: the packets, not the pixels
     stamps = None
     if settings.gyro_timestamps:
@@ -188,9 +192,26 @@ def dates_rows(settings: Settings) -> bool:
     return settings.rolling_shutter not in ("off", 0, 0.0)
 
 
+def readout_given(settings: Settings) -> bool:
+    """Whether the options name a rolling-shutter readout (a number, or the gyro's
+    estimate) rather than leaving it to the clip or the log."""
+    if settings.gyro:
+        return settings.readout_ms not in (None, 0, 0.0, "0")
+    return isinstance(settings.rolling_shutter, int | float) and settings.rolling_shutter > 0
+
+
+def sideways_readout(info: VideoInfo) -> str:
+    """Why a clip shown turned a quarter gets no rolling-shutter correction."""
+    return (
+        f"the clip is shown turned a quarter (display rotation {info.rotation}°): its "
+        "sensor's rows run down the upright frame, which the rolling-shutter correction "
+        "does not model"
+    )
+
+
 def _motion(src: Path, job: Job, settings: Settings, bar, tell) -> tuple:
     """(track, focal length, :func:`_rotations`): pass 1, with its notices."""
-    bands = READOUT_BANDS if dates_rows(settings) else 0
+    bands = READOUT_BANDS if dates_rows(settings) and not job.info.sideways else 0
     # the flow vectors (about 5 KB a pair): the repair checks a jump against them, and
     # they are measured again once a rolling shutter's rows are dated
     keep = job.log is None
@@ -225,6 +246,8 @@ def _rotations(
     if job.log is not None:
         from stabilize.gyro.path import gyro_path  # gyro mode only
 
+        if job.info.sideways:  # the log's or the lens's readout (a given one is refused)
+            settings = replace(settings, readout_ms=0.0)
         R, rolling, summary = gyro_path(
             settings, job.log, track, job.info.height, job.lens, job.stamps
         )
@@ -236,9 +259,12 @@ def _rotations(
             refined = partial(samples.refined, focal=focal)
         R, reliable = repair_unreliable(track.rotations, track.support, agreeing, refined)
         rolling, summary = None, None
-        from stabilize.shutter import readout_for, visual_rolling_shutter
+        from stabilize.shutter import Readout, readout_for, visual_rolling_shutter
 
-        shutter, spline = readout_for(settings.rolling_shutter, track)
+        if job.info.sideways and settings.rolling_shutter != "off":
+            shutter, spline = Readout(0.0, "refused", reason=sideways_readout(job.info)), None
+        else:
+            shutter, spline = readout_for(settings.rolling_shutter, track)
         if shutter is not None and shutter.source != "off":
             tell(f"rolling shutter: {shutter.describe()}")
         if spline is not None:

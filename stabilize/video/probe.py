@@ -58,6 +58,12 @@ class VideoInfo:
         return (self.height, self.width)
 
     @property
+    def sideways(self) -> bool:
+        """Whether the frames are shown turned a quarter (a phone held upright): decoded
+        upright, the sensor's rows then run down the frame, not across it."""
+        return self.rotation in (90, 270)
+
+    @property
     def video_delay(self) -> float:
         """How late the first video stream starts after the file's first stream, s (a TS
         recording's video often starts some ms after its audio)."""

@@ -121,22 +121,16 @@ def test_a_static_clip_comes_out_unchanged(tmp_path):
     assert np.abs(a - b).mean() < 2.5  # compression only
 
 
+def held_upright(clip: Path, folder: Path) -> Path:
+    """``clip`` tagged to be shown turned a quarter, as a phone held upright records."""
+    rotated = folder / "portrait.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-display_rotation", "90", "-i", str(clip)]
+    subprocess.run([*cmd, "-c", "copy", str(rotated)], check=True)
+    return rotated
+
+
 def test_portrait_rotation_metadata_is_honoured(shaky, tmp_path):
-    rotated = tmp_path / "portrait.mp4"
-    cmd = [
-        ffmpeg_exe(),
-        "-hide_banner",
-        "-loglevel",
-        "error",
-        "-display_rotation",
-        "90",
-        "-i",
-        str(shaky),
-        "-c",
-        "copy",
-        str(rotated),
-    ]
-    subprocess.run(cmd, check=True)
+    rotated = held_upright(shaky, tmp_path)
     info = probe(rotated)
     assert info.rotation in (90, 270) and info.size == (320, 180)  # displayed upright
     # the default field of view spans the long side, however the phone was held
@@ -150,6 +144,23 @@ def test_portrait_rotation_metadata_is_honoured(shaky, tmp_path):
     result = probe(out)
     assert result.size == (320, 180) and result.rotation == 0
     assert summary["frames"] == 60
+
+
+def test_a_clip_held_upright_gets_no_rolling_shutter_correction(shaky, tmp_path):
+    # Decoded upright, its sensor's rows run down the frame: a rendered 30 ms readout,
+    # tagged upright, read 3.1 ms along the rows and shook 1.875 px corrected, 1.469 not
+    rotated = held_upright(shaky, tmp_path)
+    out = tmp_path / "out.mp4"
+    summary, _ = stabilize_video(rotated, out, Settings(fov=50.0))
+    shutter = summary["rolling_shutter"]
+    assert shutter["source"] == "refused" and shutter["readout_ms"] == 0.0
+    assert "turned a quarter" in shutter["reason"]
+    with pytest.raises(ValueError, match="turned a quarter"):
+        stabilize_video(rotated, tmp_path / "given.mp4", Settings(fov=50.0, rolling_shutter=30.0))
+    assert not (tmp_path / "given.mp4").exists()
+    gyro = Settings(fov=50.0, gyro=str(shaky.parent / "gyro.csv"), readout_ms=20.0)
+    with pytest.raises(ValueError, match="turned a quarter"):
+        stabilize_video(rotated, tmp_path / "gyro.mp4", gyro)
 
 
 def test_a_10_bit_source_stays_10_bit(shaky, tmp_path):
