@@ -155,8 +155,10 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     check_encoder(dst, settings.encoding, encoded_size(info, settings))
     lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
     if info.sideways and readout_given(settings):
+        from stabilize.shutter import sideways
+
         raise ValueError(
-            f"{src}: {sideways_readout(info)}; give no readout (--rolling-shutter, --readout-ms)"
+            f"{src}: {sideways(info.rotation)}; give no readout (--rolling-shutter, --readout-ms)"
         )
     times = frame_times(src, info.input_args)  # read once: the packets, not the pixels
     stamps = None
@@ -198,15 +200,6 @@ def readout_given(settings: Settings) -> bool:
     if settings.gyro:
         return settings.readout_ms not in (None, 0, 0.0, "0")
     return isinstance(settings.rolling_shutter, int | float) and settings.rolling_shutter > 0
-
-
-def sideways_readout(info: VideoInfo) -> str:
-    """Why a clip shown turned a quarter gets no rolling-shutter correction."""
-    return (
-        f"the clip is shown turned a quarter (display rotation {info.rotation}°): its "
-        "sensor's rows run down the upright frame, which the rolling-shutter correction "
-        "does not model"
-    )
 
 
 def _motion(src: Path, job: Job, settings: Settings, bar, tell) -> tuple:
@@ -259,10 +252,10 @@ def _rotations(
             refined = partial(samples.refined, focal=focal)
         R, reliable = repair_unreliable(track.rotations, track.support, agreeing, refined)
         rolling, summary = None, None
-        from stabilize.shutter import Readout, readout_for, visual_rolling_shutter
+        from stabilize.shutter import Readout, readout_for, sideways, visual_rolling_shutter
 
         if job.info.sideways and settings.rolling_shutter != "off":
-            shutter, spline = Readout(0.0, "refused", reason=sideways_readout(job.info)), None
+            shutter, spline = Readout(0.0, "refused", reason=sideways(job.info.rotation)), None
         else:
             shutter, spline = readout_for(settings.rolling_shutter, track)
         if shutter is not None and shutter.source != "off":

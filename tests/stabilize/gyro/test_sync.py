@@ -1,4 +1,5 @@
 import json
+import subprocess
 from dataclasses import replace
 from pathlib import Path
 
@@ -14,6 +15,7 @@ from stabilize.gyro.sync import synchronise, visual_rates
 from stabilize.motion.files import read_rotations
 from stabilize.motion.track import VisualTrack
 from stabilize.synth import SynthOptions, render_clip
+from stabilize.video import ffmpeg_exe
 from tests.stabilize.helpers import SAMPLE
 
 
@@ -210,3 +212,17 @@ def test_the_axes_refinement_is_kept_only_where_the_data_support_it(sample):
     tilted = synchronise(GyroLog(log.times, log.rates @ T.T, "tilted"), track)
     assert so3.angular_error_deg(tilted.R_cam_imu, true_axes @ T.T) < 1.0
     assert so3.angular_error_deg(tilted.R_cam_imu, true_axes) > 4.0
+
+
+def test_compare_dates_no_rows_of_a_clip_held_upright(tmp_path):
+    # decoded upright, its sensor's rows run down the frame: no readout is estimated or
+    # taken for it
+    upright = tmp_path / "upright.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-display_rotation", "90", "-i", str(SAMPLE / "clip.mp4")]
+    subprocess.run([*cmd, "-c", "copy", str(upright)], check=True)
+    args = ["compare", str(upright), "--gyro", str(SAMPLE / "gyro.csv"), "-q", "--json"]
+    given = CliRunner().invoke(app, [*args, "--readout-ms", "20"])
+    assert given.exit_code == 2 and "turned a quarter" in given.output
+    result = CliRunner().invoke(app, [*args, "--readout-ms", "auto"])
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.output)["readout_ms"] == 0.0
