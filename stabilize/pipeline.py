@@ -153,7 +153,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     info = probe(src)
     check_writable(dst)
     check_encoder(dst, settings.encoding, encoded_size(info, settings))
-    lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
+    lens = read_lens_profile(settings.lens, info.size, info.rotation) if settings.lens else None
     if info.sideways and readout_given(settings):
         from stabilize.shutter import sideways
 

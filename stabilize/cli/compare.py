@@ -138,7 +138,7 @@ def _comparison(params: dict, bar: ProgressFactory):
     info, times = _video_and_times(
         params["video"], params["start_number"], params["fps"], params["gyro_timestamps"]
     )
-    camera = read_lens_profile(params["lens"], info.size) if params["lens"] else None
+    camera = read_lens_profile(params["lens"], info.size, info.rotation) if params["lens"] else None
     if camera is not None and calibrate:
         raise ValueError("--calibrate-focal fits a pinhole focal length; --lens brings its own")
     if camera is not None:

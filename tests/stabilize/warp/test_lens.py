@@ -2,6 +2,7 @@
 stabilised end to end with --lens."""
 
 import json
+import subprocess
 from pathlib import Path
 
 import cv2
@@ -12,7 +13,7 @@ from rotation import so3
 from rotation.camera import intrinsics
 from stabilize import Settings, estimate_rotations, stabilize_video
 from stabilize.motion.files import read_rotations
-from stabilize.video import FrameWriter, probe, read_frames
+from stabilize.video import FrameWriter, ffmpeg_exe, probe, read_frames
 from stabilize.warp.frames import warp_frame
 from stabilize.warp.homography import homography
 from stabilize.warp.lens import Lens, LensError, pinhole_map, project, read_lens_profile, unproject
@@ -160,3 +161,31 @@ def test_stabilising_a_fisheye_clip_with_its_lens_profile(fisheye_clip, tmp_path
         assert covers(planned.K, C, zoom, size, lens=planned.lens)
     means = [frame.mean() for frame in read_frames(out)]
     assert len(means) == 90 and min(means) > 20  # warped content, not black
+
+
+@pytest.mark.parametrize(("rotation", "turns"), [(90, 1), (270, 3)])
+def test_a_profile_turns_with_a_clip_shown_upright(tmp_path, rotation, turns):
+    # FFmpeg shows a clip tagged with a display rotation as np.rot90 of its stored frames
+    tagged = tmp_path / "upright.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-display_rotation", str(rotation)]
+    subprocess.run([*cmd, "-i", str(SAMPLE / "clip.mp4"), "-c", "copy", str(tagged)], check=True)
+    first = next(iter(read_frames(SAMPLE / "clip.mp4")))
+    np.testing.assert_array_equal(next(iter(read_frames(tagged))), np.rot90(first, turns))
+    # a sensor calibrated off-centre, its pixels' images where np.rot90 puts those pixels
+    path = tmp_path / "p.json"
+    matrix = [[900.0, 0, 700.0], [0, 880.0, 300.0], [0, 0, 1]]
+    fisheye = {"camera_matrix": matrix, "distortion_coeffs": COEFFS}
+    path.write_text(
+        json.dumps({"calib_dimension": {"w": 1280, "h": 720}, "fisheye_params": fisheye})
+    )
+    stored = read_lens_profile(path, (360, 640))
+    shown = read_lens_profile(path, (640, 360), rotation)
+    rays = np.random.default_rng(0).normal([0, 0, 3], 1, (50, 3))
+    x, y = np.round(project(stored, rays)).astype(int).T  # pixels of a 360×640 frame
+    inside = (x >= 0) & (x < 640) & (y >= 0) & (y < 360)
+    index = np.rot90(np.arange(360 * 640).reshape(360, 640), turns)
+    where = {v: (j, i) for (i, j), v in np.ndenumerate(index)}
+    expected = np.array([where[v] for v in y[inside] * 640 + x[inside]])
+    turned = rays @ (so3.exp_so3([0, 0, np.radians(-rotation)]).T)  # the camera's own axes
+    got = project(shown, turned[inside])
+    np.testing.assert_allclose(got, expected, atol=0.5 + 1e-9)
