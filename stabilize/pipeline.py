@@ -155,10 +155,11 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     check_encoder(dst, settings.encoding, encoded_size(info, settings))
     lens = read_lens_profile(settings.lens, info.size, info.rotation) if settings.lens else None
     if info.sideways and readout_given(settings):
-        from stabilize.shutter import sideways
+        from stabilize.shutter import sideways_reason
 
         raise ValueError(
-            f"{src}: {sideways(info.rotation)}; give no readout (--rolling-shutter, --readout-ms)"
+            f"{src}: {sideways_reason(info.rotation)}; give no readout (--rolling-shutter, "
+            "--readout-ms)"
         )
     times = frame_times(src, info.input_args)  # read once: the packets, not the pixels
     stamps = None
@@ -252,10 +253,13 @@ def _rotations(
             refined = partial(samples.refined, focal=focal)
         R, reliable = repair_unreliable(track.rotations, track.support, agreeing, refined)
         rolling, summary = None, None
-        from stabilize.shutter import Readout, readout_for, sideways, visual_rolling_shutter
+        from stabilize.shutter import Readout, readout_for, sideways_reason, visual_rolling_shutter
 
-        if job.info.sideways and settings.rolling_shutter != "off":
-            shutter, spline = Readout(0.0, "refused", reason=sideways(job.info.rotation)), None
+        if job.info.sideways and settings.rolling_shutter == "auto":
+            shutter, spline = (
+                Readout(0.0, "refused", reason=sideways_reason(job.info.rotation)),
+                None,
+            )
         else:
             shutter, spline = readout_for(settings.rolling_shutter, track)
         if shutter is not None and shutter.source != "off":

@@ -148,10 +148,12 @@ def _comparison(params: dict, bar: ProgressFactory):
     given = log.readout_s or (camera and camera.readout_s)
     known = given if parsed == "auto" else readout_seconds(parsed, None)
     if info.sideways:  # decoded upright, the sensor's rows run down the frame
-        from stabilize.shutter import sideways
+        from stabilize.shutter import sideways_reason
 
         if parsed not in (None, "auto") and readout_seconds(parsed, None):
-            raise ValueError(f"{params['video']}: {sideways(info.rotation)}; give no readout")
+            raise ValueError(
+                f"{params['video']}: {sideways_reason(info.rotation)}; give no readout"
+            )
         known = 0.0
     options = SyncOptions(
         params["gyro_offset"], R_cam_imu, known, params["gyro_drift"], params["gyro_search"]

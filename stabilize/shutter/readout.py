@@ -78,7 +78,7 @@ class Readout:
         return f"{fit} (estimated)"
 
 
-def sideways(rotation: int) -> str:
+def sideways_reason(rotation: int) -> str:
     """Why a clip shown turned a quarter (display ``rotation`` 90° or 270°: a phone held
     upright) gets no rolling-shutter correction: decoded upright, its sensor's rows run
     down the frame, and the bands and the warp date rows across it."""
