@@ -149,7 +149,6 @@ def main() -> None:
     for given in args.clips or clips(work):
         name = f"{given.parent.name}/{given.name}"[-27:]
         tag = f"{given.parent.name}_{given.stem}"  # the rendered walks are all clip.mp4
-        clip = given
         clip = viewed(given, work / f"{tag}_view.mp4", view)
         info = probe(clip)
         mine, theirs = work / f"{tag}_ours.mp4", work / f"{tag}_vidstab.mp4"

@@ -73,7 +73,8 @@ def read_lens_profile(path: str | Path, size: tuple[int, int], rotation: int = 0
     if abs((w / h) / (cw / ch) - 1.0) > 0.01:
         raise LensError(
             f"{path}: calibrated at {cw:.0f}x{ch:.0f}, a different aspect ratio from the "
-            f"video's {w}x{h}; choose the profile for this recording mode"
+            f"video's {w}x{h}{' as its sensor stores it' if turned else ''}; choose the "
+            "profile for this recording mode"
         )
     readout = profile.get("frame_readout_time")
     readout_s = float(readout) / 1000.0 if readout else None
