@@ -38,6 +38,7 @@ the median ratio is then given of the means too.
     python bench/real_bench.py --zoom 2        # each clip's middle half, at its own size
     python bench/real_bench.py --portrait      # each clip's middle 9:16, upright
     python bench/real_bench.py --every 2       # every other frame, at half the rate
+    python bench/real_bench.py --crf 32        # each clip compressed as a shared clip is
 
 ``--width`` scales every clip down (FFmpeg, bicubic, CRF 14, limited range) before either
 tool sees it: the literature's "Regular" clips are 640×360, and there the lead is
@@ -47,7 +48,8 @@ that no tool is told, where a wrong focal length shows most. ``--portrait`` keep
 clip's middle 9:16 of its height first: a clip shot with the phone held upright, decoded
 upright, whose default field of view spans its height. ``--every 2`` keeps every other
 frame, at half the rate: twice the motion a pair, as a walk at 15 fps, or past nearer
-surfaces, would show.
+surfaces, would show. ``--crf 32`` encodes each view as coarsely as a clip shared on the
+web often is (each view is otherwise CRF 14).
 """
 
 from __future__ import annotations
@@ -75,6 +77,7 @@ if TYPE_CHECKING:
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
 REAL = ("handheld/cockatoo.mp4", "gopro/karma.mp4", "gopro/hero7.mp4", "gopro/max-heromode.mp4")
+VIEW_CRF = 14  # each view's encoding: close to its source
 JUMP_PX = 2.0  # a frame's high-passed zoom beyond this is a jump between depth layers
 RENDERED_FOV = (30.0, 45.0, 100.0)  # walks past near walls, at these unknown fields of view
 WALK = 1.4  # m/s, the rendered walks' pace
@@ -131,6 +134,7 @@ def main() -> None:
         "--portrait", action="store_true", help="keep each clip's middle 9:16 first (upright)"
     )
     parser.add_argument("--every", type=int, default=1, help="keep every EVERY-th frame first")
+    parser.add_argument("--crf", type=int, default=VIEW_CRF, help="encode each view at this CRF")
     args = parser.parse_args()
     if args.width is not None and args.width < 16:
         parser.error("--width must be at least 16 px")
@@ -138,7 +142,9 @@ def main() -> None:
         parser.error("--zoom must be between 1 and 8")
     if not 1 <= args.every <= 8:
         parser.error("--every must be between 1 and 8")
-    view = View(args.width, args.zoom or 1.0, args.portrait, args.every)
+    if not 0 <= args.crf <= 51:
+        parser.error("--crf must be between 0 and 51")
+    view = View(args.width, args.zoom or 1.0, args.portrait, args.every, args.crf)
     work = Path(tempfile.mkdtemp(prefix="real-bench-"))
     ratios, mean_ratios = [], []
     header = (
@@ -191,12 +197,14 @@ class View:
     """How the bench sees a clip: with ``portrait`` its middle 9:16 of the frame's height
     (a phone held upright: decoded upright, its long side is its height), then the middle
     1/``zoom`` of each side, scaled to ``width`` (its aspect kept, even sides; None: its
-    own width, never up from there), every ``every``-th frame at 1/``every`` the rate."""
+    own width, never up from there), every ``every``-th frame at 1/``every`` the rate,
+    encoded at ``crf`` (x264)."""
 
     width: int | None = None
     zoom: float = 1.0
     portrait: bool = False
     every: int = 1
+    crf: int = VIEW_CRF
 
 
 def viewed(clip: Path, dst: Path, view: View) -> Path:
@@ -208,14 +216,15 @@ def viewed(clip: Path, dst: Path, view: View) -> Path:
     if upright:
         w = 2 * round(h * 9 / 32)
     out = min(view.width or w, w)
-    if view == View(width=view.width) and out == w:
+    if view == View(width=view.width) and out == w:  # nothing to change: the clip itself
         return clip
     crop = f"{middle(w, h, 1 / view.zoom)}," if view.zoom != 1.0 else ""
     rate = (info.fps or 30.0) / view.every
     sparse = f"select=not(mod(n\\,{view.every})),setpts=N/({rate}*TB)," if view.every > 1 else ""
     chain = f"{sparse}{upright}{crop}scale={out}:-2:flags=bicubic"
     cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-map", "0:v:0", "-vf", chain]
-    codec = ["-r", f"{rate}", "-c:v", "libx264", "-crf", "14", "-pix_fmt", "yuv420p", "-an"]
+    codec = ["-r", f"{rate}", "-c:v", "libx264", "-crf", str(view.crf), "-pix_fmt", "yuv420p"]
+    codec.append("-an")
     subprocess.run([*cmd, *codec, str(dst)], check=True)
     return dst
 
