@@ -123,22 +123,24 @@ def estimate_readout(track: VisualTrack) -> tuple[Readout, Spline | None]:
         reason = "too few frames with texture across their height"
         return Readout(0.0, "refused", reason=reason), None
     r, stderr, bands, knots, scale = found
+    readout = decide(r, stderr, frame)
+    if not readout.seconds:
+        return readout, None
+    half = len(searched.rotations) // 2
+    halves = [_search(searched.pairs(a, b), frame) for a, b in ((0, half), (half, 2 * half))]
+    # a half that reads an impossible readout measured none, and contradicts nothing
+    if all(h is not None and _possible(h[0], frame) for h in halves):
+        (r1, s1, *_), (r2, s2, *_) = halves
+        if halves_disagree(r1, s1, r2, s2):
+            reason = (
+                f"the clip's halves disagree ({1000 * r1:.1f} ± {1000 * s1:.1f} and "
+                f"{1000 * r2:.1f} ± {1000 * s2:.1f} ms): not the sensor's"
+            )
+            return Readout(0.0, "refused", r, stderr, reason), None
     if first is not None:  # the attitude of the whole clip
         bands, knots = Bands.of(track), knots_for(track.times)
         scale = cauchy_scale(bands, r, knots)
-    readout, spline = decide(bands, r, stderr, frame, knots, scale)
-    if readout.seconds > 0:
-        half = len(searched.rotations) // 2
-        halves = [_search(searched.pairs(a, b), frame) for a, b in ((0, half), (half, 2 * half))]
-        # a half that reads an impossible readout measured none, and contradicts nothing
-        if all(h is not None and _possible(h[0], frame) for h in halves):
-            (r1, s1, *_), (r2, s2, *_) = halves
-            if halves_disagree(r1, s1, r2, s2):
-                reason = (
-                    f"the clip's halves disagree ({1000 * r1:.1f} ± {1000 * s1:.1f} and "
-                    f"{1000 * r2:.1f} ± {1000 * s2:.1f} ms): not the sensor's"
-                )
-                return Readout(0.0, "refused", r, stderr, reason), None
+    spline, _, _ = fit_attitude(bands, r, knots, scale)
     return readout, spline
 
 
@@ -195,21 +197,20 @@ def cauchy_scale(bands: Bands, readout: float, knots: NDArray) -> float:
     return 1.4826 * float(np.median(error[bands.usable])) + 1e-12
 
 
-def decide(
-    bands: Bands, r: float, stderr: float, frame: float, knots: NDArray, scale: float
-) -> tuple[Readout, Spline | None]:
-    """Refuse an uncertain or impossible readout, call a negligible one 0."""
+def decide(r: float, stderr: float, frame: float) -> Readout:
+    """Refuse an uncertain or impossible readout r (s, with σ ``stderr``, at a frame
+    interval ``frame``), call a negligible one 0; the attitude is fitted only to one
+    kept."""
     if not stderr <= MAX_STDERR * frame:
-        return Readout(0.0, "refused", r, stderr, "the motion does not pin it down"), None
+        return Readout(0.0, "refused", r, stderr, "the motion does not pin it down")
     if r >= LONGEST * frame:
-        return Readout(0.0, "refused", r, stderr, "longer than a frame interval"), None
+        return Readout(0.0, "refused", r, stderr, "longer than a frame interval")
     if r <= SHORTEST * frame:
         reason = "negative: a bottom-to-top readout is not modelled"
-        return Readout(0.0, "refused", r, stderr, reason), None
+        return Readout(0.0, "refused", r, stderr, reason)
     if r < max(SIGNIFICANT * stderr, MIN_READOUT):
-        return Readout(0.0, "estimated", r, stderr, "no rolling shutter measured"), None
-    spline, _, _ = fit_attitude(bands, r, knots, scale)
-    return Readout(r, "estimated", r, stderr), spline
+        return Readout(0.0, "estimated", r, stderr, "no rolling shutter measured")
+    return Readout(r, "estimated", r, stderr)
 
 
 def curvature_stderr(bands: Bands, r: float, knots: NDArray, scale: float, h: float) -> float:
