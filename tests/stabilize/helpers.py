@@ -3,6 +3,7 @@ small synthetic inputs. Not part of the package: the library works on whole clip
 
 from __future__ import annotations
 
+import subprocess
 from pathlib import Path
 
 import cv2
@@ -10,6 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rotation import so3
+from stabilize.video import ffmpeg_exe
 from stabilize.warp.coverage import Framing
 from stabilize.warp.lens import Lens
 from stabilize.warp.remap import remap_from
@@ -17,6 +19,15 @@ from stabilize.warp.sources import lens_source, rolling_source
 
 # The bundled sample: a rendered street clip with its truth, gyro log and frame times.
 SAMPLE = Path(__file__).resolve().parents[2] / "samples" / "street"
+
+
+def held_upright(clip: Path, folder: Path, rotation: int = 90) -> Path:
+    """``clip`` tagged to be shown turned ``rotation``° (counter-clockwise), as a phone
+    held upright records: the same stream, copied."""
+    rotated = folder / f"upright{rotation}.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-display_rotation", str(rotation), "-i", str(clip)]
+    subprocess.run([*cmd, "-c", "copy", str(rotated)], check=True)
+    return rotated
 
 
 def covers(K, C, zoom, size, rows=None, lens: Lens | None = None) -> bool:

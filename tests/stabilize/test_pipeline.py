@@ -14,6 +14,7 @@ from stabilize.motion.focal import initial_focal
 from stabilize.synth import SynthOptions, trajectory
 from stabilize.video import ffmpeg_exe, frame_times, probe, read_frames
 from tests.stabilize.conftest import render
+from tests.stabilize.helpers import held_upright
 
 
 @pytest.fixture(scope="module")
@@ -119,14 +120,6 @@ def test_a_static_clip_comes_out_unchanged(tmp_path):
     a = np.stack(list(read_frames(clip))).astype(float)
     b = np.stack(list(read_frames(out))).astype(float)
     assert np.abs(a - b).mean() < 2.5  # compression only
-
-
-def held_upright(clip: Path, folder: Path) -> Path:
-    """``clip`` tagged to be shown turned a quarter, as a phone held upright records."""
-    rotated = folder / "portrait.mp4"
-    cmd = [ffmpeg_exe(), "-v", "error", "-display_rotation", "90", "-i", str(clip)]
-    subprocess.run([*cmd, "-c", "copy", str(rotated)], check=True)
-    return rotated
 
 
 def test_portrait_rotation_metadata_is_honoured(shaky, tmp_path):

@@ -1,5 +1,4 @@
 import json
-import subprocess
 from dataclasses import replace
 from pathlib import Path
 
@@ -15,8 +14,7 @@ from stabilize.gyro.sync import synchronise, visual_rates
 from stabilize.motion.files import read_rotations
 from stabilize.motion.track import VisualTrack
 from stabilize.synth import SynthOptions, render_clip
-from stabilize.video import ffmpeg_exe
-from tests.stabilize.helpers import SAMPLE
+from tests.stabilize.helpers import SAMPLE, held_upright
 
 
 @pytest.fixture(scope="module")
@@ -217,9 +215,7 @@ def test_the_axes_refinement_is_kept_only_where_the_data_support_it(sample):
 def test_compare_dates_no_rows_of_a_clip_held_upright(tmp_path):
     # decoded upright, its sensor's rows run down the frame: no readout is estimated or
     # taken for it
-    upright = tmp_path / "upright.mp4"
-    cmd = [ffmpeg_exe(), "-v", "error", "-display_rotation", "90", "-i", str(SAMPLE / "clip.mp4")]
-    subprocess.run([*cmd, "-c", "copy", str(upright)], check=True)
+    upright = held_upright(SAMPLE / "clip.mp4", tmp_path)
     args = ["compare", str(upright), "--gyro", str(SAMPLE / "gyro.csv"), "-q", "--json"]
     given = CliRunner().invoke(app, [*args, "--readout-ms", "20"])
     assert given.exit_code == 2 and "turned a quarter" in given.output

@@ -17,6 +17,7 @@ from stabilize import Settings
 from stabilize.motion.estimate import estimate_rotations
 from stabilize.motion.focal import FULL_FRAME_DIAGONAL_MM, estimate_motion, initial_focal
 from stabilize.video import ffmpeg_exe, probe
+from tests.stabilize.helpers import held_upright
 
 
 def tagged(shaky: Path, folder: Path, mm: float) -> Path:
@@ -114,9 +115,7 @@ def test_the_search_spans_the_same_fields_of_view_however_the_camera_is_held(
 ):
     # 15–150° across the long side, as the default's 69°: a portrait clip's telephoto
     # (23° across its height, 13° across its width) lies inside it, as held level
-    upright = tmp_path / "upright.mp4"
-    cmd = [ffmpeg_exe(), "-v", "error", "-display_rotation", "90", "-i", str(shaky)]
-    subprocess.run([*cmd, "-c", "copy", str(upright)], check=True)
+    upright = held_upright(shaky, tmp_path)
     searched = []
 
     def search(*args):

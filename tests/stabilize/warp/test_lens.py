@@ -2,7 +2,6 @@
 stabilised end to end with --lens."""
 
 import json
-import subprocess
 from pathlib import Path
 
 import cv2
@@ -13,11 +12,11 @@ from rotation import so3
 from rotation.camera import intrinsics
 from stabilize import Settings, estimate_rotations, stabilize_video
 from stabilize.motion.files import read_rotations
-from stabilize.video import FrameWriter, ffmpeg_exe, probe, read_frames
+from stabilize.video import FrameWriter, probe, read_frames
 from stabilize.warp.frames import warp_frame
 from stabilize.warp.homography import homography
 from stabilize.warp.lens import Lens, LensError, pinhole_map, project, read_lens_profile, unproject
-from tests.stabilize.helpers import SAMPLE, covers, warp_frame_lens
+from tests.stabilize.helpers import SAMPLE, covers, held_upright, warp_frame_lens
 
 COEFFS = [0.03, -0.01, 0.004, -0.001]
 
@@ -166,9 +165,7 @@ def test_stabilising_a_fisheye_clip_with_its_lens_profile(fisheye_clip, tmp_path
 @pytest.mark.parametrize(("rotation", "turns"), [(90, 1), (270, 3)])
 def test_a_profile_turns_with_a_clip_shown_upright(tmp_path, rotation, turns):
     # FFmpeg shows a clip tagged with a display rotation as np.rot90 of its stored frames
-    tagged = tmp_path / "upright.mp4"
-    cmd = [ffmpeg_exe(), "-v", "error", "-display_rotation", str(rotation)]
-    subprocess.run([*cmd, "-i", str(SAMPLE / "clip.mp4"), "-c", "copy", str(tagged)], check=True)
+    tagged = held_upright(SAMPLE / "clip.mp4", tmp_path, rotation)
     first = next(iter(read_frames(SAMPLE / "clip.mp4")))
     np.testing.assert_array_equal(next(iter(read_frames(tagged))), np.rot90(first, turns))
     # a sensor calibrated off-centre, its pixels' images where np.rot90 puts those pixels
