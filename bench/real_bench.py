@@ -212,9 +212,10 @@ def viewed(clip: Path, dst: Path, view: View) -> Path:
     all of it)."""
     info = probe(clip)
     w, h = info.width, info.height
-    upright = f"crop={2 * round(h * 9 / 32)}:{h}," if view.portrait and w > h * 9 / 16 else ""
-    if upright:
-        w = 2 * round(h * 9 / 32)
+    upright = ""
+    if view.portrait and w > h * 9 / 16:
+        w = 2 * round(h * 9 / 32)  # even
+        upright = f"crop={w}:{h},"
     out = min(view.width or w, w)
     if view == View(width=view.width) and out == w:  # nothing to change: the clip itself
         return clip
@@ -223,8 +224,8 @@ def viewed(clip: Path, dst: Path, view: View) -> Path:
     sparse = f"select=not(mod(n\\,{view.every})),setpts=N/({rate}*TB)," if view.every > 1 else ""
     chain = f"{sparse}{upright}{crop}scale={out}:-2:flags=bicubic"
     cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-map", "0:v:0", "-vf", chain]
-    codec = ["-r", f"{rate}", "-c:v", "libx264", "-crf", str(view.crf), "-pix_fmt", "yuv420p"]
-    codec.append("-an")
+    codec = ["-r", f"{rate}", "-c:v", "libx264", "-crf", str(view.crf)]
+    codec += ["-pix_fmt", "yuv420p", "-an"]
     subprocess.run([*cmd, *codec, str(dst)], check=True)
     return dst
 
