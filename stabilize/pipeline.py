@@ -19,7 +19,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 from functools import partial
 from pathlib import Path
 from threading import Thread
@@ -115,7 +115,7 @@ def stabilize_video(
         "input": str(src),
         "output": str(dst),
         "frames": frames,
-        "size": [job.info.width, job.info.height],
+        "size": list(job.info.shown_size[::-1]),  # as shown
         "focal_px": float(K[0, 0]),
         "focal": focal.summary(),
         "zoom": float(planned.zoom.max()),
@@ -150,17 +150,10 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
         from stabilize.gyro.load import load_gyro
 
         log = load_gyro(settings)
-    info = probe(src)
+    info = probe(src).stored()  # the sensor's rows, whichever way the camera was held
     check_writable(dst)
     check_encoder(dst, settings.encoding, encoded_size(info, settings))
-    lens = read_lens_profile(settings.lens, info.size, info.rotation) if settings.lens else None
-    if info.sideways and readout_given(settings):
-        from stabilize.shutter import sideways_reason
-
-        raise ValueError(
-            f"{src}: {sideways_reason(info.rotation)}; give no readout (--rolling-shutter, "
-            "--readout-ms)"
-        )
+    lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
     times = frame_times(src, info.input_args)  # read once: the packets, not the pixels
     stamps = None
     if settings.gyro_timestamps:
@@ -169,11 +162,11 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
         stamps = sensor_frame_times(settings.gyro_timestamps, 0, len(times))
     mux = keep_streams(info, container_for(dst), info.video_delay)
     notices = mux.notices
-    if not settings.size and frame_size(info, settings) != info.size:
-        h, w = frame_size(info, settings)
+    if not settings.size and frame_size(info, settings) != info.shown_size:
+        (h, w), (sh, sw) = frame_size(info, settings), info.shown_size
         notices += (
-            f"{info.width}x{info.height} has an odd side: the output is {w}x{h}, the last "
-            "row or column cropped (4:2:0 video needs even sides)",
+            f"{sw}x{sh} has an odd side: the output is {w}x{h}, the last row or column "
+            "cropped (4:2:0 video needs even sides)",
         )
     return Job(info, times, lens, log, stamps, mux, notices)
 
@@ -195,17 +188,9 @@ def dates_rows(settings: Settings) -> bool:
     return settings.rolling_shutter not in ("off", 0, 0.0)
 
 
-def readout_given(settings: Settings) -> bool:
-    """Whether the options name a rolling-shutter readout (a number, or the gyro's
-    estimate) rather than leaving it to the clip or the log."""
-    if settings.gyro:
-        return settings.readout_ms not in (None, 0, 0.0, "0")
-    return isinstance(settings.rolling_shutter, int | float) and settings.rolling_shutter > 0
-
-
 def _motion(src: Path, job: Job, settings: Settings, bar, tell) -> tuple:
     """(track, focal length, :func:`_rotations`): pass 1, with its notices."""
-    bands = READOUT_BANDS if dates_rows(settings) and not job.info.sideways else 0
+    bands = READOUT_BANDS if dates_rows(settings) else 0
     # the flow vectors (about 5 KB a pair): the repair checks a jump against them, and
     # they are measured again once a rolling shutter's rows are dated
     keep = job.log is None
@@ -240,8 +225,6 @@ def _rotations(
     if job.log is not None:
         from stabilize.gyro.path import gyro_path  # gyro mode only
 
-        if job.info.sideways:  # the log's or the lens's readout (a given one is refused)
-            settings = replace(settings, readout_ms=0.0)
         R, rolling, summary = gyro_path(
             settings, job.log, track, job.info.height, job.lens, job.stamps
         )
@@ -253,15 +236,9 @@ def _rotations(
             refined = partial(samples.refined, focal=focal)
         R, reliable = repair_unreliable(track.rotations, track.support, agreeing, refined)
         rolling, summary = None, None
-        from stabilize.shutter import Readout, readout_for, sideways_reason, visual_rolling_shutter
+        from stabilize.shutter import readout_for, visual_rolling_shutter
 
-        if job.info.sideways and settings.rolling_shutter == "auto":
-            shutter, spline = (
-                Readout(0.0, "refused", reason=sideways_reason(job.info.rotation)),
-                None,
-            )
-        else:
-            shutter, spline = readout_for(settings.rolling_shutter, track)
+        shutter, spline = readout_for(settings.rolling_shutter, track)
         if shutter is not None and shutter.source != "off":
             tell(f"rolling shutter: {shutter.describe()}")
         if spline is not None:

@@ -11,9 +11,10 @@ from dataclasses import dataclass, field
 from stabilize.video.encode import Encoding
 
 # A phone's main camera is about 26 mm full-frame equivalent: 69° across the long side,
-# however the phone is held. A portrait clip is decoded upright, so that side is its
-# height: 69° across its width would model a 9:16 clip's camera 1.78× too wide, the
-# costly direction (a wrong f's keystone grows with |1/f'² - 1/f²|)
+# however the phone is held. A portrait clip's long side is its height (one re-encoded
+# upright; one with a display rotation is worked on as stored): 69° across its width
+# would model a 9:16 clip's camera 1.78× too wide, the costly direction (a wrong f's
+# keystone grows with |1/f'² - 1/f²|)
 DEFAULT_FOV = 69.0
 # Crop at most 13% of each side: about what FFmpeg's vid.stab zooms to (optzoom=1). Where
 # removing all the shake would need more, the path keeps as little of it as a linear

@@ -138,7 +138,7 @@ def _comparison(params: dict, bar: ProgressFactory):
     info, times = _video_and_times(
         params["video"], params["start_number"], params["fps"], params["gyro_timestamps"]
     )
-    camera = read_lens_profile(params["lens"], info.size, info.rotation) if params["lens"] else None
+    camera = read_lens_profile(params["lens"], info.size) if params["lens"] else None
     if camera is not None and calibrate:
         raise ValueError("--calibrate-focal fits a pinhole focal length; --lens brings its own")
     if camera is not None:
@@ -147,14 +147,6 @@ def _comparison(params: dict, bar: ProgressFactory):
     parsed = readout(params["readout_ms"], params["gyro"])
     given = log.readout_s or (camera and camera.readout_s)
     known = given if parsed == "auto" else readout_seconds(parsed, None)
-    if info.sideways:  # decoded upright, the sensor's rows run down the frame
-        from stabilize.shutter import sideways_reason
-
-        if parsed not in (None, "auto") and readout_seconds(parsed, None):
-            raise ValueError(
-                f"{params['video']}: {sideways_reason(info.rotation)}; give no readout"
-            )
-        known = 0.0
     options = SyncOptions(
         params["gyro_offset"], R_cam_imu, known, params["gyro_drift"], params["gyro_search"]
     )
@@ -180,7 +172,7 @@ def _video_and_times(
     from stabilize.video import frame_times, probe, sequence_args
 
     args = sequence_args(video, start_number, fps)
-    info = probe(video, args)
+    info = probe(video, args).stored()  # the sensor's rows and axes, however it was held
     times = frame_times(video, args)
     if timestamps is not None:
         from stabilize.gyro.readers import sensor_frame_times

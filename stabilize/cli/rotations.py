@@ -61,7 +61,7 @@ def rotations(
             fail(f"{target} exists (use --overwrite to replace it)")
         run_or_fail(lambda target=target: check_writable(target))
     settings = flow_settings(flow_name, raft_weights, device, fov=field_of_view(fov), focal=focal)
-    info = run_or_fail(lambda: probe(input_path))
+    info = run_or_fail(lambda: probe(input_path).stored())  # the sensor's axes, as compare's
 
     def estimate(bar):
         return estimate_motion(input_path, info, settings, bar("estimating", None))

@@ -112,15 +112,15 @@ def _exif_35mm(info: VideoInfo) -> float | None:
 def initial_focal(settings: Settings, info: VideoInfo, lens: Lens | None) -> FocalChoice:
     """The focal length pass 1 starts from: given, the lens's, the metadata's, or the
     default; the last two are where the estimate starts (:func:`estimate_motion`)."""
-    width = info.width
+    width = info.shown_size[1]  # --fov, and the summary's, span the width as shown
     meta = metadata_focal(info)
     if settings.fov_given:
-        return FocalChoice(settings.focal_px(info.size), width, "given", metadata_px=meta)
+        return FocalChoice(settings.focal_px(info.shown_size), width, "given", metadata_px=meta)
     if lens is not None:
         return FocalChoice(float(lens.K[0, 0]), width, "lens", metadata_px=meta)
     if meta is not None:
         return FocalChoice(meta, width, "metadata", metadata_px=meta)
-    return FocalChoice(settings.focal_px(info.size), width, "default")
+    return FocalChoice(settings.focal_px(info.shown_size), width, "default")
 
 
 def estimate_motion(

@@ -14,7 +14,6 @@ _EXPORTS = {
     "Readout": "stabilize.shutter.readout",
     "estimate_readout": "stabilize.shutter.readout",
     "readout_for": "stabilize.shutter.readout",
-    "sideways_reason": "stabilize.shutter.readout",
     "visual_attitude": "stabilize.shutter.attitude",
     "visual_rolling_shutter": "stabilize.shutter.rows",
 }

@@ -78,16 +78,6 @@ class Readout:
         return f"{fit} (estimated)"
 
 
-def sideways_reason(rotation: int) -> str:
-    """Why a clip shown turned a quarter (display ``rotation`` 90° or 270°: a phone held
-    upright) gets no rolling-shutter correction: decoded upright, its sensor's rows run
-    down the frame, and the bands and the warp date rows across it."""
-    return (
-        f"the clip is shown turned a quarter (display rotation {rotation}°): its sensor's "
-        "rows run down the upright frame, which the rolling-shutter correction does not model"
-    )
-
-
 def _ms(seconds: float | None) -> float | None:
     return None if seconds is None else 1000.0 * float(seconds)
 

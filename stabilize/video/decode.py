@@ -27,13 +27,16 @@ def read_frames(
     ``pix_fmt="yuv420p"`` gives I420 frames (3H/2, W) instead (:mod:`stabilize.yuv`), and
     ``"yuv420p10le"`` 10-bit ones (uint16).
 
-    FFmpeg applies the display rotation, so frames come upright. A stream that ends
+    FFmpeg applies the display rotation, so frames come upright, unless ``info`` is
+    :meth:`VideoInfo.stored`: they then come as the sensor stored them. A stream that ends
     early or breaks raises :class:`VideoError` after the frames that did decode.
     """
     info = info or probe(path)
     h, w = size or info.size
     args = info.input_args
     options = {k.lstrip("-"): v for k, v in zip(args[::2], args[1::2], strict=True)}
+    if not info.autorotate:
+        options["noautorotate"] = None
     shrink = size is not None and size != info.size
     if shrink:
         # Deblocking only smooths detail that the downscale averages away anyway; skipping

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import re
 import subprocess
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from stabilize.video.binary import ffmpeg_exe
@@ -38,7 +38,7 @@ class VideoInfo:
     """What FFmpeg reports of a video: its first video stream, and every stream it has."""
 
     path: Path | str
-    width: int  # as displayed, after the container's rotation
+    width: int  # as decoded: as shown, after the display rotation (unless ``autorotate`` is off)
     height: int
     fps: float
     duration: float | None
@@ -52,16 +52,32 @@ class VideoInfo:
     chapters: int = 0
     metadata: str = ""  # the file's own tags as FFmpeg lists them (before its streams)
     colour: Colour = UNKNOWN  # range, matrix, primaries, transfer: kept in the output
+    autorotate: bool = True  # whether FFmpeg turns the frames by the display rotation
 
     @property
     def size(self) -> tuple[int, int]:
         return (self.height, self.width)
 
     @property
-    def sideways(self) -> bool:
-        """Whether the frames are shown turned a quarter (a phone held upright): decoded
-        upright, the sensor's rows then run down the frame, not across it."""
-        return self.rotation in (90, 270)
+    def turns(self) -> int:
+        """Quarter turns, counter-clockwise, from the decoded frames to the shown ones
+        (as ``np.rot90``): 0 unless the display rotation is left to the caller."""
+        return 0 if self.autorotate else self.rotation // 90
+
+    @property
+    def shown_size(self) -> tuple[int, int]:
+        """(H, W) of the frames as a player shows them."""
+        return self.size[::-1] if self.turns % 2 else self.size
+
+    def stored(self) -> VideoInfo:
+        """The video as its sensor stored it: decoded without the display rotation
+        (FFmpeg's ``-autorotate 0``) where it is a whole number of quarter turns. Its
+        rows are then the sensor's rows, read out one after another under a rolling
+        shutter, however the camera was held; :attr:`turns` turns them to be shown."""
+        if not self.autorotate or self.rotation not in (90, 180, 270):
+            return self
+        h, w = self.size[::-1] if self.rotation != 180 else self.size
+        return replace(self, width=w, height=h, autorotate=False)
 
     @property
     def video_delay(self) -> float:

@@ -43,11 +43,9 @@ class Lens:
     source: str = ""
 
 
-def read_lens_profile(path: str | Path, size: tuple[int, int], rotation: int = 0) -> Lens:
-    """A Gyroflow lens profile, scaled to a video of (H, W) pixels as decoded: upright,
-    where the video is shown turned a quarter (display ``rotation`` 90° or 270°, a phone
-    held upright), while the profile is calibrated on the frames as the sensor stores
-    them (:func:`upright`)."""
+def read_lens_profile(path: str | Path, size: tuple[int, int]) -> Lens:
+    """A Gyroflow lens profile, scaled to a video of (H, W) pixels as its sensor stores
+    them (:meth:`stabilize.video.VideoInfo.stored`), the frames it was calibrated on."""
     path = Path(path)
     try:
         profile = json.loads(path.read_text())
@@ -68,30 +66,15 @@ def read_lens_profile(path: str | Path, size: tuple[int, int], rotation: int = 0
         raise LensError(f"{path}: missing or malformed lens field {err}") from None
     if coeffs.size != 4 or not np.isfinite(K).all() or K[0, 0] <= 0 or cw <= 0 or ch <= 0:
         raise LensError(f"{path}: needs a camera matrix, 4 fisheye coefficients and a size")
-    turned = rotation in (90, 270)
-    h, w = size[::-1] if turned else size  # as the sensor stores them
+    h, w = size
     if abs((w / h) / (cw / ch) - 1.0) > 0.01:
         raise LensError(
             f"{path}: calibrated at {cw:.0f}x{ch:.0f}, a different aspect ratio from the "
-            f"video's {w}x{h}{' as its sensor stores it' if turned else ''}; choose the "
-            "profile for this recording mode"
+            f"video's {w}x{h} as stored; choose the profile for this recording mode"
         )
     readout = profile.get("frame_readout_time")
     readout_s = float(readout) / 1000.0 if readout else None
-    K = scale_intrinsics(K, w / cw, h / ch)
-    return Lens(upright(K, (h, w), rotation) if turned else K, coeffs, readout_s, str(path))
-
-
-def upright(K: NDArray, stored: tuple[int, int], rotation: int) -> NDArray[np.float64]:
-    """The camera matrix of frames stored (H, W) = ``stored`` as they are shown turned
-    ``rotation`` (90° or 270°, counter-clockwise; FFmpeg decodes them so). A stored
-    pixel (x, y) is shown at (y, W-1-x) turned 90° and at (H-1-y, x) turned 270°: the
-    camera turned about its axis, so fx and fy swap and the principal point moves with
-    the pixels; the fisheye's distortion, a function of the angle from the axis, stays."""
-    H, W = stored
-    fx, fy, cx, cy = K[0, 0], K[1, 1], K[0, 2], K[1, 2]
-    centre = (cy, W - 1 - cx) if rotation == 90 else (H - 1 - cy, cx)
-    return np.array([[fy, 0.0, centre[0]], [0.0, fx, centre[1]], [0.0, 0.0, 1.0]])
+    return Lens(scale_intrinsics(K, w / cw, h / ch), coeffs, readout_s, str(path))
 
 
 def project(lens: Lens, rays: NDArray) -> NDArray[np.float64]:

@@ -1,7 +1,9 @@
 """Pass 2: decode at full size, warp each frame along the planned path, encode.
 
 Pass 2 stays in I420 from decoder to encoder where the sizes allow (both sides even):
-no colour conversion on either side, and half the bytes through the pipes.
+no colour conversion on either side, and half the bytes through the pipes. A clip
+decoded as its sensor stored it (:meth:`stabilize.video.VideoInfo.stored`) is turned to
+be shown once warped: the output is written upright, with no display rotation.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from stabilize.video import FrameWriter, VideoInfo, i420, read_frames
 from stabilize.video.containers import container_for
 from stabilize.video.encode import Mux
 from stabilize.video.retime import is_variable_rate, retime
+from stabilize.video.turn import turn
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.frames import resize_image
 from stabilize.warp.planes import resize_planes
@@ -76,9 +79,11 @@ def render(
                     planned.warp_many(batch, settings.device, info.colour.full_range),
                     strict=True,
                 ):
+                    if info.turns:
+                        frame, warped = (turn(f, info.turns, planar) for f in (frame, warped))
                     if settings.size:
                         frame, warped = resize(frame, (h, w)), resize(warped, (h, w))
-                    elif (h, w) != info.size:  # odd sides: one row or column off the edge
+                    elif (h, w) != info.shown_size:  # odd sides: one row or column off the edge
                         frame, warped = frame[:h, :w], warped[:h, :w]
                     writer.write(side_by_side(frame, warped) if settings.preview else warped)
                     written += 1
@@ -92,10 +97,10 @@ def render(
 
 
 def frame_size(info: VideoInfo, settings: Settings) -> tuple[int, int]:
-    """(H, W) of each stabilised frame: ``--size``, else the input's with odd sides
-    rounded down (4:2:0 video needs even sides; the last row or column is cropped, the
-    smallest loss, and at the frame's edge, which the zoom crops anyway)."""
-    h, w = settings.size or info.size
+    """(H, W) of each stabilised frame as shown: ``--size``, else the input's with odd
+    sides rounded down (4:2:0 video needs even sides; the last row or column is cropped,
+    the smallest loss, and at the frame's edge, which the zoom crops anyway)."""
+    h, w = settings.size or info.shown_size
     return h - h % 2, w - w % 2
 
 

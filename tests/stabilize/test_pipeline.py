@@ -139,21 +139,27 @@ def test_portrait_rotation_metadata_is_honoured(shaky, tmp_path):
     assert summary["frames"] == 60
 
 
-def test_a_clip_held_upright_gets_no_rolling_shutter_correction(shaky, tmp_path):
-    # Decoded upright, its sensor's rows run down the frame: a rendered 30 ms readout,
-    # tagged upright, read 3.1 ms along the rows and shook 1.875 px corrected, 1.469 not
-    rotated = held_upright(shaky, tmp_path)
-    out = tmp_path / "out.mp4"
-    summary, _ = stabilize_video(rotated, out, Settings(fov=50.0))
-    shutter = summary["rolling_shutter"]
-    assert shutter["source"] == "refused" and shutter["readout_ms"] == 0.0
-    assert "turned a quarter" in shutter["reason"]
-    with pytest.raises(ValueError, match="turned a quarter"):
-        stabilize_video(rotated, tmp_path / "given.mp4", Settings(fov=50.0, rolling_shutter=30.0))
-    assert not (tmp_path / "given.mp4").exists()
-    gyro = Settings(fov=50.0, gyro=str(shaky.parent / "gyro.csv"), readout_ms=20.0)
-    with pytest.raises(ValueError, match="turned a quarter"):
-        stabilize_video(rotated, tmp_path / "gyro.mp4", gyro)
+@pytest.mark.parametrize("rotation", [90, 180])
+def test_a_clip_held_upright_is_stabilised_as_its_sensor_stored_it(shaky, tmp_path, rotation):
+    # Its rows are the sensor's, read out in order: decoded upright, a rendered 30 ms
+    # readout tagged upright read 3.1 ms along the rows; as stored it reads 28.9, as level
+    level, upright = tmp_path / "level.mp4", tmp_path / "upright.mp4"
+    settings = Settings(focal=340.0, preview=True)  # --fov spans the width as shown
+    wanted, _ = stabilize_video(shaky, level, settings)
+    got, _ = stabilize_video(held_upright(shaky, tmp_path, rotation), upright, settings)
+    assert got["rolling_shutter"] == wanted["rolling_shutter"]
+    assert got["rolling_shutter"]["source"] == "estimated"
+    assert got["zoom"] == wanted["zoom"] and got["focal"]["px"] == wanted["focal"]["px"]
+    # shown upright, the original beside the stabilised frame, with no display rotation
+    assert probe(upright).rotation == 0 and got["size"] == (
+        wanted["size"][::-1] if rotation == 90 else wanted["size"]
+    )
+    pairs = zip(read_frames(upright), read_frames(level), strict=True)
+    for shown, frame in pairs:
+        w = frame.shape[1] // 2
+        halves = (np.rot90(frame[:, :w], rotation // 90), np.rot90(frame[:, w:], rotation // 90))
+        expected = np.hstack(halves).astype(int)
+        assert np.abs(shown.astype(int) - expected).mean() < 4  # the encoders' own loss
 
 
 def test_a_10_bit_source_stays_10_bit(shaky, tmp_path):
