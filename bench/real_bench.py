@@ -39,6 +39,7 @@ the median ratio is then given of the means too.
     python bench/real_bench.py --portrait      # each clip's middle 9:16, upright
     python bench/real_bench.py --every 2       # every other frame, at half the rate
     python bench/real_bench.py --crf 32        # each clip compressed as a shared clip is
+    python bench/real_bench.py --rotation 90   # each clip tagged as a phone held upright
 
 ``--width`` scales every clip down (FFmpeg, bicubic, CRF 14, limited range) before either
 tool sees it: the literature's "Regular" clips are 640×360, and there the lead is
@@ -49,7 +50,10 @@ clip's middle 9:16 of its height first: a clip shot with the phone held upright,
 upright, whose default field of view spans its height. ``--every 2`` keeps every other
 frame, at half the rate: twice the motion a pair, as a walk at 15 fps, or past nearer
 surfaces, would show. ``--crf 32`` encodes each view as coarsely as a clip shared on the
-web often is (each view is otherwise CRF 14).
+web often is (each view is otherwise CRF 14). ``--rotation 90`` tags each view with that
+display rotation, the stream copied: a phone held upright stores its frames level, with
+its sensor's rows in readout order, and asks the player to turn them (the content then
+shows on its side, which neither tool nor the metric minds).
 """
 
 from __future__ import annotations
@@ -59,7 +63,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -135,6 +139,9 @@ def main() -> None:
     )
     parser.add_argument("--every", type=int, default=1, help="keep every EVERY-th frame first")
     parser.add_argument("--crf", type=int, default=VIEW_CRF, help="encode each view at this CRF")
+    parser.add_argument(
+        "--rotation", type=int, default=0, choices=(0, 90, 180, 270), help="tag each view so"
+    )
     args = parser.parse_args()
     if args.width is not None and args.width < 16:
         parser.error("--width must be at least 16 px")
@@ -144,7 +151,7 @@ def main() -> None:
         parser.error("--every must be between 1 and 8")
     if not 0 <= args.crf <= 51:
         parser.error("--crf must be between 0 and 51")
-    view = View(args.width, args.zoom or 1.0, args.portrait, args.every, args.crf)
+    view = View(args.width, args.zoom or 1.0, args.portrait, args.every, args.crf, args.rotation)
     work = Path(tempfile.mkdtemp(prefix="real-bench-"))
     ratios, mean_ratios = [], []
     header = (
@@ -198,13 +205,14 @@ class View:
     (a phone held upright: decoded upright, its long side is its height), then the middle
     1/``zoom`` of each side, scaled to ``width`` (its aspect kept, even sides; None: its
     own width, never up from there), every ``every``-th frame at 1/``every`` the rate,
-    encoded at ``crf`` (x264)."""
+    encoded at ``crf`` (x264), then tagged to be shown turned ``rotation``°."""
 
     width: int | None = None
     zoom: float = 1.0
     portrait: bool = False
     every: int = 1
     crf: int = VIEW_CRF
+    rotation: int = 0
 
 
 def viewed(clip: Path, dst: Path, view: View) -> Path:
@@ -217,16 +225,23 @@ def viewed(clip: Path, dst: Path, view: View) -> Path:
         w = 2 * round(h * 9 / 32)  # even
         upright = f"crop={w}:{h},"
     out = min(view.width or w, w)
-    if view == View(width=view.width) and out == w:  # nothing to change: the clip itself
-        return clip
-    crop = f"{middle(w, h, 1 / view.zoom)}," if view.zoom != 1.0 else ""
-    rate = (info.fps or 30.0) / view.every
-    sparse = f"select=not(mod(n\\,{view.every})),setpts=N/({rate}*TB)," if view.every > 1 else ""
-    chain = f"{sparse}{upright}{crop}scale={out}:-2:flags=bicubic"
-    cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-map", "0:v:0", "-vf", chain]
-    codec = ["-r", f"{rate}", "-c:v", "libx264", "-crf", str(view.crf)]
-    codec += ["-pix_fmt", "yuv420p", "-an"]
-    subprocess.run([*cmd, *codec, str(dst)], check=True)
+    level = dst.with_name(f"{dst.stem}_level{dst.suffix}") if view.rotation else dst
+    if replace(view, rotation=0) == View(width=view.width) and out == w:
+        level = clip  # nothing to change but the tag, if any: the clip itself
+    else:
+        crop = f"{middle(w, h, 1 / view.zoom)}," if view.zoom != 1.0 else ""
+        rate = (info.fps or 30.0) / view.every
+        every = view.every
+        sparse = f"select=not(mod(n\\,{every})),setpts=N/({rate}*TB)," if every > 1 else ""
+        chain = f"{sparse}{upright}{crop}scale={out}:-2:flags=bicubic"
+        cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-map", "0:v:0", "-vf", chain]
+        codec = ["-r", f"{rate}", "-c:v", "libx264", "-crf", str(view.crf)]
+        codec += ["-pix_fmt", "yuv420p", "-an"]
+        subprocess.run([*cmd, *codec, str(level)], check=True)
+    if not view.rotation:
+        return level
+    tag = [ffmpeg_exe(), "-v", "error", "-y", "-display_rotation", str(view.rotation)]
+    subprocess.run([*tag, "-i", str(level), "-map", "0:v:0", "-c", "copy", str(dst)], check=True)
     return dst
 
 
