@@ -71,7 +71,7 @@ class VideoInfo:
 
     def stored(self) -> VideoInfo:
         """The video as its sensor stored it: decoded without the display rotation
-        (FFmpeg's ``-autorotate 0``) where it is a whole number of quarter turns. Its
+        (FFmpeg's ``-noautorotate``) where it is a whole number of quarter turns. Its
         rows are then the sensor's rows, read out one after another under a rolling
         shutter, however the camera was held; :attr:`turns` turns them to be shown."""
         if not self.autorotate or self.rotation not in (90, 180, 270):

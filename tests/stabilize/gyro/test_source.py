@@ -10,7 +10,7 @@ from stabilize.gyro import GyroError, GyroLog, read_gyro
 from stabilize.gyro.export import write_gcsv
 from stabilize.gyro.load import lowpass
 from stabilize.gyro.sync import visual_rates
-from tests.stabilize.helpers import SAMPLE
+from tests.stabilize.helpers import SAMPLE, held_upright
 
 
 def test_gcsv_export_round_trips_through_the_reader(tmp_path):
@@ -119,6 +119,19 @@ def test_rolling_shutter_correction_from_the_gyro(tmp_path):
     # Given a readout, the offset found is the first row's: the content's (0.35 s, a global
     # shutter) minus the readout times the mean height of the vectors, which is 0..1.
     assert 0.35 - 0.020 < summary["gyro"]["offset_s"] < 0.35 - 0.002
+
+
+def test_a_clip_held_upright_is_stabilised_from_the_gyro_as_held_level(tmp_path):
+    # worked on as its sensor stored it: the same rows, offset and axes as held level
+    upright = held_upright(SAMPLE / "clip.mp4", tmp_path)
+    args = ["--gyro", str(SAMPLE / "gyro.csv"), "--focal", "554", "--readout-ms", "20"]
+    gyro = []
+    for clip in (SAMPLE / "clip.mp4", upright):
+        out = tmp_path / f"{clip.stem}_out.mp4"
+        result = CliRunner().invoke(app, ["run", str(clip), str(out), *args, "-q", "--json"])
+        assert result.exit_code == 0, result.output
+        gyro.append(json.loads(result.stdout)["gyro"])
+    assert gyro[1] == gyro[0] and gyro[1]["readout_ms"] == 20.0
 
 
 def test_readout_needs_the_gyro(tmp_path):
