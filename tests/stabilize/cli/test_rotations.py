@@ -3,6 +3,7 @@
 from typer.testing import CliRunner
 
 from stabilize.cli import app
+from tests.stabilize.helpers import held_upright
 
 
 def test_rotations_command(shaky, tmp_path):
@@ -11,3 +12,14 @@ def test_rotations_command(shaky, tmp_path):
     assert result.exit_code == 0, result.output
     lines = out.read_text().splitlines()
     assert lines[0] == "frame,t,rx,ry,rz,support" and len(lines) == 60
+
+
+def test_a_clip_held_upright_gives_its_sensors_rotations(shaky, tmp_path):
+    # the sensor's axes, which a gyro is fixed to, however the camera was held
+    files = []
+    for clip in (shaky, held_upright(shaky, tmp_path)):
+        out = tmp_path / f"{clip.stem}.csv"
+        args = ["rotations", str(clip), "-o", str(out), "-q", "--focal", "300"]
+        assert CliRunner().invoke(app, args).exit_code == 0
+        files.append(out.read_text())
+    assert files[1] == files[0]
