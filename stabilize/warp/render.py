@@ -14,6 +14,7 @@ from itertools import islice
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
@@ -60,6 +61,17 @@ def render(
         encoding = replace(encoding, pix_fmt=pix_fmt)  # keep a 10-bit source's depth
     side_by_side = i420.hstack if planar else lambda a, b: np.hstack([a, b])
     resize = resize_planes if planar else resize_image
+
+    def shown(frame: NDArray) -> NDArray:
+        """A decoded or warped frame as it is written: turned to be shown, then at the
+        output's size."""
+        frame = turn(frame, info.turns, planar)
+        if settings.size:
+            return resize(frame, (h, w))
+        if (h, w) != info.shown_size:  # odd sides: one row or column off the edge
+            return frame[:h, :w]
+        return frame
+
     try:
         with FrameWriter(
             target,
@@ -79,13 +91,8 @@ def render(
                     planned.warp_many(batch, settings.device, info.colour.full_range),
                     strict=True,
                 ):
-                    if info.turns:
-                        frame, warped = (turn(f, info.turns, planar) for f in (frame, warped))
-                    if settings.size:
-                        frame, warped = resize(frame, (h, w)), resize(warped, (h, w))
-                    elif (h, w) != info.shown_size:  # odd sides: one row or column off the edge
-                        frame, warped = frame[:h, :w], warped[:h, :w]
-                    writer.write(side_by_side(frame, warped) if settings.preview else warped)
+                    warped = shown(warped)
+                    writer.write(side_by_side(shown(frame), warped) if settings.preview else warped)
                     written += 1
                     progress(1)
         if variable:
