@@ -112,7 +112,8 @@ GyroAxesOption = Annotated[
     typer.Option(
         "--gyro-axes",
         help="The IMU axis of camera x, y and z as three letters, e.g. YXz: camera x is "
-        "IMU +Y, y is +X, z is -Z (lower case: the negative axis). Default: found.",
+        "IMU +Y, y is +X, z is -Z (lower case: the negative axis); the camera's axes as "
+        "its sensor stores the frames, however the phone was held. Default: found.",
     ),
 ]
 GyroSearchOption = Annotated[

@@ -45,7 +45,9 @@ def rotations(
     overwrite: OverwriteOption = False,
     quiet: QuietOption = False,
 ) -> None:
-    """Estimate only: the camera rotation R_t of every frame pair (radians)."""
+    """Estimate only: the camera rotation R_t of every frame pair (radians), in the
+    camera's axes as its sensor stores the frames (a clip shown turned, as a phone held
+    upright records, is read unturned)."""
     from rotation import so3
     from stabilize.cli.bars import with_bars
     from stabilize.motion.files import write_rotations
