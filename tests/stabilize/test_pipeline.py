@@ -140,9 +140,10 @@ def test_portrait_rotation_metadata_is_honoured(shaky, tmp_path):
 
 
 @pytest.mark.parametrize("rotation", [90, 180])
-def test_a_clip_held_upright_is_stabilised_as_its_sensor_stored_it(shaky, tmp_path, rotation):
-    # Its rows are the sensor's, read out in order: decoded upright, a rendered 30 ms
-    # readout tagged upright read 3.1 ms along the rows; as stored it reads 28.9, as level
+def test_a_turned_clip_is_stabilised_as_its_sensor_stored_it(shaky, tmp_path, rotation):
+    # A phone held upright (90°) or upside down (180°). Its rows are the sensor's, read out
+    # in order: decoded upright, a rendered 30 ms readout tagged upright read 3.1 ms along
+    # the rows, and tagged upside down -6.7; as stored both read 28.9, as level
     level, upright = tmp_path / "level.mp4", tmp_path / "upright.mp4"
     settings = Settings(focal=340.0, preview=True)  # --fov spans the width as shown
     wanted, _ = stabilize_video(shaky, level, settings)
