@@ -46,8 +46,9 @@ tool sees it: the literature's "Regular" clips are 640×360, and there the lead 
 smaller (README). ``--zoom`` keeps the middle 1/Z of each side instead, scaled back to
 the clip's size (or to ``--width``), as a digital zoom does: a narrower field of view
 that no tool is told, where a wrong focal length shows most. ``--portrait`` keeps each
-clip's middle 9:16 of its height first: a clip shot with the phone held upright, decoded
-upright, whose default field of view spans its height. ``--every 2`` keeps every other
+clip's middle 9:16 of its height first: a clip shot upright and stored upright (an
+editor's or a messenger's copy, with no display rotation), whose default field of view
+spans its height. ``--every 2`` keeps every other
 frame, at half the rate: twice the motion a pair, as a walk at 15 fps, or past nearer
 surfaces, would show. ``--crf 32`` encodes each view as coarsely as a clip shared on the
 web often is (each view is otherwise CRF 14). ``--rotation 90`` tags each view with that
@@ -202,7 +203,7 @@ def main() -> None:
 @dataclass(frozen=True)
 class View:
     """How the bench sees a clip: with ``portrait`` its middle 9:16 of the frame's height
-    (a phone held upright: decoded upright, its long side is its height), then the middle
+    (a clip stored upright: its long side is its height), then the middle
     1/``zoom`` of each side, scaled to ``width`` (its aspect kept, even sides; None: its
     own width, never up from there), every ``every``-th frame at 1/``every`` the rate,
     encoded at ``crf`` (x264), then tagged to be shown turned ``rotation``°."""
