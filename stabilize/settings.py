@@ -42,7 +42,7 @@ class Settings:
 
     flow: str = "dis"  # flow backend (flow.BACKENDS)
     flow_options: dict = field(default_factory=dict)
-    fov: float | str | None = None  # horizontal field of view, degrees; None or "auto": estimated
+    fov: float | str | None = None  # across the long side, degrees; None or "auto": estimated
     focal: float | None = None  # pixels; overrides fov
     smooth: float = 0.5  # smoothing time constant, s
     method: str = "adaptive"  # smoothing method (stabilize.path.smoothing.METHODS)
@@ -75,14 +75,14 @@ class Settings:
 
     def focal_px(self, size: tuple[int, int]) -> float:
         """The focal length in pixels for frames of ``size`` (h, w): ``focal``; else
-        ``fov`` across the width; else ``DEFAULT_FOV`` across the long side."""
+        ``fov``, or ``DEFAULT_FOV``, across the long side (a camera's field of view as
+        its maker quotes it, the one across a level frame, however it was held)."""
         if self.focal is not None:
             return float(self.focal)
         from rotation.camera import focal_from_fov  # the estimator's package is heavy
 
-        if isinstance(self.fov, int | float):
-            return focal_from_fov(self.fov, size[1])
-        return focal_from_fov(DEFAULT_FOV, max(size))
+        given = isinstance(self.fov, int | float)
+        return focal_from_fov(self.fov if given else DEFAULT_FOV, max(size))
 
     @property
     def fov_given(self) -> bool:

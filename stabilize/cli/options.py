@@ -37,10 +37,11 @@ DeviceOption = Annotated[
 FovOption = Annotated[
     str | None,
     typer.Option(
-        help="Horizontal field of view, degrees (1–179). Default (auto): estimated from "
-        "the clip's own motion, starting from the file's metadata (a phone's 35 mm "
-        "equivalent) or 69° across the long side (a phone's main camera, held either "
-        "way), which stay where the motion does not pin it down.",
+        help="Field of view across the frame's long side (the horizontal one of a level "
+        "frame, however the camera was held), degrees (1–179). Default (auto): estimated "
+        "from the clip's own motion, starting from the file's metadata (a phone's 35 mm "
+        "equivalent) or 69° (a phone's main camera), which stay where the motion does "
+        "not pin it down.",
     ),
 ]
 FocalOption = Annotated[

@@ -70,7 +70,8 @@ def rotations(
 
     announce_compiling()
     track, focal = run_or_fail(lambda: with_bars(estimate, quiet=quiet))
-    notice(f"focal length {focal.px:.1f} px ({focal.fov_deg:.1f}° across, {focal.source})")
+    across = f"{focal.fov_deg:.1f}° across the long side"
+    notice(f"focal length {focal.px:.1f} px ({across}, {focal.source})")
     if output is not None:
         with atomic_output(output, overwrite=overwrite) as tmp:
             write_rotations(tmp, track.times[:-1], so3.log_so3(track.rotations), track.support)

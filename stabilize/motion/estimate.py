@@ -240,7 +240,7 @@ def _estimator_and_frames(
     through a fisheye ``lens``, their pinhole view."""
     frames = read_frames(path, ws.size, info)
     if lens is None:
-        focal = settings.focal_px(info.shown_size) * ws.scale[0]
+        focal = settings.focal_px(info.size) * ws.scale[0]
         return HoughEstimator(ws.size, focal, max_deg=settings.max_deg), frames
     K_ws = scale_intrinsics(lens.K, *ws.scale)
     focal, center = float(K_ws[0, 0]), (float(K_ws[0, 2]), float(K_ws[1, 2]))

@@ -57,7 +57,7 @@ class FocalChoice:
     ``given``, ``lens``, ``metadata``, ``estimated`` or ``default``."""
 
     px: float
-    width: int
+    span: int  # px the field of view spans: the frame's long side
     source: str
     estimated_px: float | None = None
     metadata_px: float | None = None
@@ -65,7 +65,7 @@ class FocalChoice:
 
     @property
     def fov_deg(self) -> float:
-        return fov_from_focal(self.px, self.width)
+        return fov_from_focal(self.px, self.span)
 
     def summary(self) -> dict:
         return {
@@ -112,15 +112,15 @@ def _exif_35mm(info: VideoInfo) -> float | None:
 def initial_focal(settings: Settings, info: VideoInfo, lens: Lens | None) -> FocalChoice:
     """The focal length pass 1 starts from: given, the lens's, the metadata's, or the
     default; the last two are where the estimate starts (:func:`estimate_motion`)."""
-    width = info.shown_size[1]  # --fov, and the summary's, span the width as shown
+    span = max(info.size)  # as --fov's, however the camera was held
     meta = metadata_focal(info)
     if settings.fov_given:
-        return FocalChoice(settings.focal_px(info.shown_size), width, "given", metadata_px=meta)
+        return FocalChoice(settings.focal_px(info.size), span, "given", metadata_px=meta)
     if lens is not None:
-        return FocalChoice(float(lens.K[0, 0]), width, "lens", metadata_px=meta)
+        return FocalChoice(float(lens.K[0, 0]), span, "lens", metadata_px=meta)
     if meta is not None:
-        return FocalChoice(meta, width, "metadata", metadata_px=meta)
-    return FocalChoice(settings.focal_px(info.shown_size), width, "default")
+        return FocalChoice(meta, span, "metadata", metadata_px=meta)
+    return FocalChoice(settings.focal_px(info.size), span, "default")
 
 
 def estimate_motion(
@@ -190,7 +190,7 @@ def _resolved(start: FocalChoice, px: float) -> FocalChoice:
     if meta and abs(px / meta - 1) <= DISAGREES:
         return replace(start, estimated_px=px)
     note = f"{100 * (px / meta - 1):+.0f}% off the metadata's (a digital zoom?)" if meta else ""
-    return FocalChoice(px, start.width, "estimated", px, meta, note)
+    return FocalChoice(px, start.span, "estimated", px, meta, note)
 
 
 def focal_from_track(

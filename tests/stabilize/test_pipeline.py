@@ -2,6 +2,7 @@
 zoom, rotation metadata, bit depth."""
 
 import json
+import math
 import subprocess
 from pathlib import Path
 
@@ -137,6 +138,10 @@ def test_portrait_rotation_metadata_is_honoured(shaky, tmp_path):
     result = probe(out)
     assert result.size == (320, 180) and result.rotation == 0
     assert summary["frames"] == 60
+    # and so does a given one, the figure a maker quotes
+    given = summary["focal"]
+    assert given["px"] == pytest.approx(160 / math.tan(math.radians(25)))
+    assert given["fov_deg"] == pytest.approx(50.0)
 
 
 @pytest.mark.parametrize("rotation", [90, 180])
@@ -145,12 +150,12 @@ def test_a_turned_clip_is_stabilised_as_its_sensor_stored_it(shaky, tmp_path, ro
     # in order: decoded upright, a rendered 30 ms readout tagged upright read 3.1 ms along
     # the rows, and tagged upside down -6.7; as stored both read 28.9, as level
     level, upright = tmp_path / "level.mp4", tmp_path / "upright.mp4"
-    settings = Settings(focal=340.0, preview=True)  # --fov spans the width as shown
+    settings = Settings(fov=50.0, preview=True)
     wanted, _ = stabilize_video(shaky, level, settings)
     got, _ = stabilize_video(held_upright(shaky, tmp_path, rotation), upright, settings)
     assert got["rolling_shutter"] == wanted["rolling_shutter"]
     assert got["rolling_shutter"]["source"] == "estimated"
-    assert got["zoom"] == wanted["zoom"] and got["focal"]["px"] == wanted["focal"]["px"]
+    assert got["zoom"] == wanted["zoom"] and got["focal"] == wanted["focal"]
     # shown upright, the original beside the stabilised frame, with no display rotation
     assert probe(upright).rotation == 0 and got["size"] == (
         wanted["size"][::-1] if rotation == 90 else wanted["size"]
