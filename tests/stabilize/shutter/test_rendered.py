@@ -10,6 +10,7 @@ from stabilize import Settings, stabilize_video
 from stabilize.evaluate.metrics import evaluate_pair
 from stabilize.synth import SynthOptions, render_clip
 from stabilize.video import probe, read_frames
+from tests.stabilize.helpers import held_upright
 
 SIZE = (270, 480)
 
@@ -46,6 +47,21 @@ def test_the_readout_is_found_and_the_wobble_undone(jello, tmp_path):
     corrected, uncorrected = (
         measured(jello, tmp_path / "auto.mp4").wobble_px,
         measured(jello, tmp_path / "off.mp4").wobble_px,
+    )
+    assert corrected < 0.4 * uncorrected
+
+
+def test_a_phone_held_upright_has_its_readout_found_and_its_wobble_undone(jello, tmp_path):
+    # stored level with a display rotation: its rows are the sensor's, as held level
+    upright = held_upright(jello, tmp_path)
+    whole = Settings(fov=70.0, max_zoom=1.3, max_stretch=100.0)
+    summary, _ = stabilize_video(upright, tmp_path / "auto.mp4", whole)
+    assert summary["rolling_shutter"]["readout_ms"] == pytest.approx(25.0, abs=2.5)
+    off = Settings(fov=70.0, max_zoom=1.3, rolling_shutter="off")
+    stabilize_video(upright, tmp_path / "off.mp4", off)
+    corrected, uncorrected = (
+        measured(upright, tmp_path / "auto.mp4").wobble_px,
+        measured(upright, tmp_path / "off.mp4").wobble_px,
     )
     assert corrected < 0.4 * uncorrected
 
