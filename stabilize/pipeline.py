@@ -116,6 +116,8 @@ def stabilize_video(
         "output": str(dst),
         "frames": frames,
         "size": list(job.info.shown_size[::-1]),  # as shown
+        # counter-clockwise, degrees: the report's axes and pixels are the stored frames'
+        "display_rotation": job.info.rotation,
         "focal_px": float(K[0, 0]),
         "focal": focal.summary(),
         "zoom": float(planned.zoom.max()),

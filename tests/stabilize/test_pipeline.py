@@ -157,6 +157,7 @@ def test_a_turned_clip_is_stabilised_as_its_sensor_stored_it(shaky, tmp_path, ro
     assert got["rolling_shutter"]["source"] == "estimated"
     assert got["zoom"] == wanted["zoom"] and got["focal"] == wanted["focal"]
     # shown upright, the original beside the stabilised frame, with no display rotation
+    assert got["display_rotation"] == rotation and wanted["display_rotation"] == 0
     assert probe(upright).rotation == 0 and got["size"] == (
         wanted["size"][::-1] if rotation == 90 else wanted["size"]
     )
