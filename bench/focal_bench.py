@@ -48,7 +48,7 @@ from stabilize.video import probe, read_frames
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from real_bench import PHONE, WALK, ZOOM_CROP, mirrored, phone_clip, span
 
-PHONE_FOCAL = 573.85  # px at 640×480, its calibration
+PHONE_FOCAL = 573.85  # px at its frames' 800×600, their calibration
 # (FFmpeg filter, zoom): its frames' middle about the principal point (406.01, 309.01),
 # shown at 640×480
 ZOOMS = {
@@ -88,7 +88,7 @@ def exact_error(clip: Path, track: VisualTrack, focal: FocalChoice, truth: float
     rays = turns @ np.stack([x, y, np.full_like(x, f)])
     u, v = f * rays[:, 0] / rays[:, 2] - x, f * rays[:, 1] / rays[:, 2] - y
     exact = replace(track, samples=replace(track.samples, u=u, v=v))
-    found = focal_from_track(exact, estimator, max(info.size) * size.scale[0])
+    found = focal_from_track(exact, estimator, max(info.size) * size.scale[0]).focal
     return math.nan if found is None else 100 * (found / f - 1)
 
 

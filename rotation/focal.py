@@ -64,6 +64,19 @@ MIN_DEPTH = 0.25
 # asking for the rise there refused) and 0.25–0.39% at 15°; the rendered walks at 30°,
 # 45° and 100° rise 9–122% within two candidates, the synthetic crowd at 1° shake 0.13%
 MIN_RISE = 0.001
+# A deep curve that pins nothing down still rules out a focal length it reads more than
+# ``REJECT`` above its minimum, for the nearest it reads within ``ACCEPT`` of it. A
+# narrow lens's curve falls steeply from the wide side to about its true f, then lies
+# flat on the long side, where its small x²/f terms tell nothing apart: phone-cc9's real
+# frames cropped to 50°, 38°, 31° and 26° and encoded at CRF 28 pinned nothing (a rise
+# under MIN_RISE) and kept the 69° default, which their curves read 2.9-17% above their
+# floors (the 38° crop at CRF 12 too: 3.9%). On a narrow lens the default is the costly
+# side: a rendered 30° handheld clip shook 5.16 px given 69°, 3.25 at 45°, 3.00 at its
+# true 30° and 3.09 at 15°. phone-cc9's whole frames (69.8°), whose curve also lies flat
+# on its long side, read the default 1.05-1.29% above the floor as encoded four ways
+# (2.26% at CRF 32), and are kept at it
+REJECT = 0.02
+ACCEPT = 0.01
 COARSE = 25  # candidates over the whole range, log-spaced (about 13% apart at 10–150°)
 FINE = 9  # candidates from the coarse minimum's one neighbour to the other (odd)
 # The coarse grid's cheaper reading of C: every fourth sample (a diagonal pattern, so the
@@ -93,6 +106,33 @@ class FocalEstimate:
         """How far the curve rises above its minimum, as a share of its highest point."""
         top = float(self.costs.max()) if len(self.costs) else 0.0
         return float(1.0 - self.costs.min() / top) if top > 0 else 0.0
+
+    def rules_out(self, focal: float) -> bool:
+        """Whether the curve reads ``focal`` more than ``REJECT`` above its minimum, and
+        is deep enough (``MIN_DEPTH``) for that to mean something."""
+        if len(self.costs) < 2 or self.depth < MIN_DEPTH:
+            return False
+        reading = np.interp(math.log(focal), np.log(self.focals), self.costs)
+        return bool(reading > (1.0 + REJECT) * self.costs.min())
+
+    def nearest_accepted(self, focal: float) -> float:
+        """The focal length nearest ``focal`` (in log f) that the curve reads within
+        ``ACCEPT`` of its minimum, linearly between its candidates (``focal`` itself
+        where it does).
+
+        >>> f = np.geomspace(100.0, 1000.0, 5)  # a floor from 316 px on
+        >>> curve = FocalEstimate(None, f, np.array([3.0, 2.0, 1.0, 1.0, 1.0]), 40)
+        >>> curve.rules_out(150.0), round(curve.nearest_accepted(150.0), 1)
+        (True, 314.4)
+        >>> curve.rules_out(700.0), curve.nearest_accepted(700.0)
+        (False, 700.0)
+        """
+        log_f, top = math.log(focal), (1.0 + ACCEPT) * self.costs.min()
+        if np.interp(log_f, np.log(self.focals), self.costs) <= top:
+            return float(focal)
+        grid = np.linspace(*np.log(self.focals[[0, -1]]), 2001)
+        accepted = grid[np.interp(grid, np.log(self.focals), self.costs) <= top]
+        return float(np.exp(accepted[np.argmin(np.abs(accepted - log_f))]))
 
 
 @njit(cache=True, nogil=True)

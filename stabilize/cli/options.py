@@ -41,7 +41,7 @@ FovOption = Annotated[
         "frame, however the camera was held), degrees (1–179). Default (auto): estimated "
         "from the clip's own motion, starting from the file's metadata (a phone's 35 mm "
         "equivalent) or 69° (a phone's main camera), which stay where the motion does "
-        "not pin it down.",
+        "not pin it down, unless it rules them out (then the nearest it accepts).",
     ),
 ]
 FocalOption = Annotated[

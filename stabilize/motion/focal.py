@@ -10,7 +10,10 @@ at it, and the rest of the clip only at it, without decoding anything twice. Whe
 clip's start does not pin f down, the estimate is made at the end, on the clip's most
 turning ``MAX_PAIRS`` pairs, and every pair is voted again. An estimate within 15% of the
 metadata's keeps the metadata's (the finer figure); a clip that does not pin f down (a
-tripod, pure roll, too little motion) keeps the starting value, and says so.
+tripod, pure roll, too little motion) keeps the starting value, and says so, unless the
+search's curve rules that value out (:meth:`rotation.focal.FocalEstimate.rules_out`: a
+narrow lens's curve lies flat over the long focal lengths, and reads the 69° default far
+up its steep wide side); then the nearest focal length the curve accepts is taken.
 
 Phones write a 35 mm-equivalent focal length F (QuickTime's
 ``com.apple.quicktime.camera.focal_length.35mm_equivalent``, EXIF's
@@ -32,7 +35,7 @@ from numpy.typing import NDArray
 import flow
 from rotation import HoughEstimator, so3
 from rotation.camera import focal_from_fov, fov_from_focal
-from rotation.focal import estimate_focal
+from rotation.focal import FocalEstimate, estimate_focal
 from stabilize.motion.estimate import Settle, estimate_again, estimate_rotations, with_bands
 from stabilize.motion.track import VisualTrack
 from stabilize.progress import Progress, no_progress
@@ -152,7 +155,7 @@ def estimate_motion(
         return HoughEstimator(ws.size, resolved.px * ws.scale[0], max_deg=settings.max_deg)
 
     def settle(so_far: VisualTrack) -> HoughEstimator | None:
-        found = focal_from_track(so_far, start, long_side)
+        found = focal_from_track(so_far, start, long_side).focal
         if found is None:
             return None
         settled.append(_resolved(choice, found / ws.scale[0]))
@@ -172,14 +175,31 @@ def estimate_motion(
     if not auto or settled:  # the samples dropped unless asked for
         return track, settled[0] if settled else choice
     kept = (lambda t: t) if keep_samples else (lambda t: replace(t, samples=None))
-    found = focal_from_track(track, start, long_side)
-    if found is None:
+    curve = focal_from_track(track, start, long_side)
+    if curve.focal is not None:
+        resolved = _resolved(choice, curve.focal / ws.scale[0])
+    elif curve.rules_out(start.focal):  # pins none, but not this one either
+        resolved = _ruled_out(choice, curve.nearest_accepted(start.focal) / ws.scale[0])
+    else:
         note = f"the clip's motion does not pin the focal length down: {choice.source} kept"
         return kept(with_bands(start, track, bands)), replace(choice, note=note)
-    resolved = _resolved(choice, found / ws.scale[0])
     if resolved.source != "estimated":
         return kept(with_bands(start, track, bands)), resolved
     return kept(estimate_again(estimator(resolved), track, bands)), resolved
+
+
+def _ruled_out(start: FocalChoice, px: float) -> FocalChoice:
+    """The focal length ``px`` (the input's px) nearest ``start``'s that a curve which
+    pins none down accepts, where it rules ``start``'s out: taken even near the
+    metadata's, since the curve reads the metadata's clearly worse."""
+    note = (
+        f"the clip's motion pins no focal length down, but rules out the {start.source}'s "
+        f"{start.fov_deg:.1f}°: the nearest it accepts is taken"
+    )
+    meta = start.metadata_px
+    if meta:
+        note += f" ({100 * (px / meta - 1):+.0f}% off the metadata's)"
+    return FocalChoice(px, start.span, "estimated", px, meta, note)
 
 
 def _resolved(start: FocalChoice, px: float) -> FocalChoice:
@@ -195,20 +215,21 @@ def _resolved(start: FocalChoice, px: float) -> FocalChoice:
 
 def focal_from_track(
     track: VisualTrack, estimator: HoughEstimator, long_side: float
-) -> float | None:
+) -> FocalEstimate:
     """The focal length (px at the flow's size) from a track's kept samples, estimated at
     ``estimator``'s focal length, searched over ``FOV_BOUNDS`` across the frame's
-    ``long_side`` (px at the flow's size); None where the motion does not pin it down."""
+    ``long_side`` (px at the flow's size), with its cost curve; no focal length where
+    the motion does not pin it down, and no curve either where it turns too little."""
     samples = track.samples
     rotvecs = so3.log_so3(track.rotations)
     turn = np.degrees(np.hypot(rotvecs[:, 0], rotvecs[:, 1]))
     if samples is None or len(turn) < 3 or np.median(turn) < MIN_TURN_DEG:
-        return None
+        return FocalEstimate(None, np.zeros(0), np.zeros(0), 0)
     first = _most_turning(turn, MAX_PAIRS)
     part = slice(first, first + MAX_PAIRS)
     bounds = tuple(focal_from_fov(fov, long_side) for fov in FOV_BOUNDS[::-1])
     grid = estimator.grid
-    found = estimate_focal(
+    return estimate_focal(
         grid.x,
         grid.y,
         samples.u[part],
@@ -218,7 +239,6 @@ def focal_from_track(
         estimator.focal,
         bounds,
     )
-    return found.focal
 
 
 def _most_turning(turn: NDArray, n: int) -> int:

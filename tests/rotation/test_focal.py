@@ -73,6 +73,27 @@ def test_a_curve_flat_on_one_side_pins_nothing_down(monkeypatch):
         assert (estimate_focal(*args).focal is not None) is pinned
 
 
+def test_a_deep_floor_rules_out_what_it_reads_above_it():
+    """A narrow lens's curve: deep, falling from the wide side to a floor it keeps over
+    the long focal lengths, so it pins none. A start it reads over REJECT above its
+    floor is ruled out, for the nearest it reads within ACCEPT of it; a start on the
+    floor or just above is kept; a shallow curve (a subject filling the frame) rules out
+    nothing."""
+    from rotation.focal import ACCEPT, REJECT, FocalEstimate
+
+    focals = np.geomspace(200.0, 3200.0, 25)  # 800 among them
+    costs = np.maximum(1.0, 1.0 + 2.0 * np.log(800.0 / focals))  # the floor from 800 px
+    curve = FocalEstimate(None, focals, costs, 40)
+    knee = 800.0 * math.exp(-ACCEPT / 2)  # where the floor begins to rise by ACCEPT
+    assert curve.rules_out(300.0) and not curve.rules_out(1500.0)
+    assert curve.nearest_accepted(300.0) == pytest.approx(knee, rel=2e-3)
+    assert curve.nearest_accepted(1500.0) == 1500.0
+    # between ACCEPT and REJECT above the floor: not ruled out, so kept
+    assert not curve.rules_out(800.0 * math.exp(-(ACCEPT + REJECT) / 4))
+    shallow = FocalEstimate(None, focals, 1.0 + 0.2 * (costs - 1.0) / costs.max(), 40)
+    assert shallow.depth < 0.25 and not shallow.rules_out(300.0)
+
+
 @pytest.mark.parametrize("low", [0, 2, 4, 5, 8])
 def test_the_fine_grid_is_walked_down_to_its_minimum(low):
     """Downhill from the middle, reading a few candidates: the whole grid's minimum

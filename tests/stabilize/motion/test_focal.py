@@ -6,13 +6,13 @@ import math
 import subprocess
 from dataclasses import replace
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 import flow
 import stabilize.motion.focal as focal_module
+from rotation.focal import FocalEstimate
 from stabilize import Settings
 from stabilize.motion.estimate import estimate_rotations
 from stabilize.motion.focal import FULL_FRAME_DIAGONAL_MM, estimate_motion, initial_focal
@@ -110,6 +110,24 @@ def test_a_real_narrow_clip_is_estimated(shared, tmp_path, crop):
     assert focal.px == pytest.approx(573.85 * 640 / int(crop.split(":")[0]), rel=0.05)
 
 
+def test_a_narrow_clip_that_pins_nothing_leaves_the_default_it_rules_out(shared, tmp_path):
+    # phone-cc9's real frames zoomed in to 38° (f = 918.2 px at 640×480) and encoded at
+    # CRF 28: the curve falls steeply to about the true f, then lies flat on the long
+    # side (it rose 0.03% past its minimum, under MIN_RISE), so it pins nothing. It reads
+    # the 69° default (465.6 px, -49%) 6.2% above its floor, and the nearest it accepts
+    # is 735 px (-20%): on a narrow lens the default is the costly side (a rendered 30°
+    # clip shook 5.16 px given 69°, 3.25 at 45°, 3.00 at 30°, 3.09 at 15°)
+    frames = shared / "data" / "phone-cc9" / "frames" / "RE_frame-%d.jpg"
+    clip = tmp_path / "zoomed.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-framerate", "30", "-start_number", "99"]
+    view = ["-vf", "crop=400:300:206:159,scale=640:480", "-c:v", "libx264", "-crf", "28"]
+    subprocess.run([*cmd, "-i", str(frames), *view, "-pix_fmt", "yuv420p", str(clip)], check=True)
+    _, focal = estimate_motion(clip, probe(clip), Settings())
+    truth, default = 573.85 * 640 / 400, Settings().focal_px((480, 640))
+    assert focal.source == "estimated" and "rules out the default's 69.0°" in focal.note
+    assert abs(focal.px / truth - 1) < abs(default / truth - 1) / 2
+
+
 def test_the_search_spans_the_same_fields_of_view_however_the_camera_is_held(
     shaky, tmp_path, monkeypatch
 ):
@@ -120,7 +138,7 @@ def test_the_search_spans_the_same_fields_of_view_however_the_camera_is_held(
 
     def search(*args):
         searched.append(args[-1])
-        return SimpleNamespace(focal=None)
+        return FocalEstimate(None, np.zeros(0), np.zeros(0), 0)
 
     monkeypatch.setattr(focal_module, "estimate_focal", search)
     for clip in (shaky, upright):
