@@ -194,7 +194,8 @@ def _ruled_out(start: FocalChoice, px: float) -> FocalChoice:
     metadata's, since the curve reads the metadata's clearly worse."""
     note = (
         f"the clip's motion pins no focal length down, but rules out the {start.source}'s "
-        f"{start.fov_deg:.1f}°: the nearest it accepts is taken"
+        f"{start.fov_deg:.1f}°: the nearest it accepts, {fov_from_focal(px, start.span):.1f}°, "
+        "is taken"
     )
     meta = start.metadata_px
     if meta:
