@@ -115,7 +115,7 @@ def test_a_narrow_clip_that_pins_nothing_leaves_the_default_it_rules_out(shared,
     # CRF 28: the curve falls steeply to about the true f, then lies flat on the long
     # side (it rose 0.03% past its minimum, under MIN_RISE), so it pins nothing. It reads
     # the 69° default (465.6 px, -49%) 6.2% above its floor, and the nearest it accepts
-    # is 735 px (-20%): on a narrow lens the default is the costly side (a rendered 30°
+    # is 852 px (-7%): on a narrow lens the default is the costly side (a rendered 30°
     # clip shook 5.16 px given 69°, 3.25 at 45°, 3.00 at 30°, 3.09 at 15°)
     frames = shared / "data" / "phone-cc9" / "frames" / "RE_frame-%d.jpg"
     clip = tmp_path / "zoomed.mp4"
