@@ -23,6 +23,10 @@ steering the fit. The minimum over a coarse log grid of f, then a fine one, refi
 parabola, is the estimate; a curve without a clear interior minimum (a tripod, pure
 roll, too little motion), one that lies flat on one side of it, or a shallow one (a
 subject filling the frame, whose flow no focal length explains much better), gives none.
+A deep curve that gives none can still rule a focal length out, one it reads well above
+its floor (:meth:`FocalEstimate.rules_out`): a narrow lens's lies flat over the long focal
+lengths, where its x²/f terms are too small to tell apart, and rises steeply on the wide
+side.
 
 The coarse grid only has to find the minimum's neighbourhood and whether there is one,
 so it reads C on every ``THIN``-th sample, each rotation refitted in ``COARSE_ROUNDS``
