@@ -93,13 +93,13 @@ ZOOM_CROP = "crop=320:240:246:189,scale=640:480"
 PHONE = SHARED / "phone-cc9" / "frames"
 
 
-def phone_clip(out: Path, view: str | None = None) -> Path:
-    """phone-cc9's frames as an H.264 clip (CRF 12) at ``out``, through the FFmpeg filter
-    ``view`` where given."""
+def phone_clip(out: Path, view: str | None = None, crf: int = 12) -> Path:
+    """phone-cc9's frames as an H.264 clip (at ``crf``) at ``out``, through the FFmpeg
+    filter ``view`` where given."""
     pattern = ["-framerate", "30", "-start_number", "99", "-i", str(PHONE / "RE_frame-%d.jpg")]
     cmd = [ffmpeg_exe(), "-v", "error", "-y", *pattern, *(["-vf", view] if view else [])]
     subprocess.run(
-        [*cmd, "-c:v", "libx264", "-crf", "12", "-pix_fmt", "yuv420p", str(out)], check=True
+        [*cmd, "-c:v", "libx264", "-crf", str(crf), "-pix_fmt", "yuv420p", str(out)], check=True
     )
     return out
 

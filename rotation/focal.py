@@ -82,7 +82,7 @@ MIN_RISE = 0.001
 REJECT = 0.02
 # How far into the flat part: the knee itself is the costly side's edge. Within 1% of
 # the floor the four crops took 53.4°, 47.0°, 42.3° and 35.8° (f -7%, -20%, -28%, -28%);
-# within 0.5%, 47.1°, 41.2°, 36.6° and 31.5° (+6%, -8%, -15%, -17%), and the whole frames
+# within 0.5%, 47.1°, 41.2°, 36.6° and 31.5° (+7%, -7%, -16%, -18%), and the whole frames
 # at CRF 32 46.0° (+58%, where 1% took 55.8°: the cheap side); within 0.25%, 42.6° to
 # 28.2° (+19% to -8%), the whole frames at CRF 32 37.4° (+104%)
 ACCEPT = 0.005
