@@ -182,7 +182,7 @@ def estimate_motion(
         resolved = _ruled_out(choice, curve.nearest_accepted(start.focal) / ws.scale[0])
     else:
         note = f"the clip's motion does not pin the focal length down: {choice.source} kept"
-        return kept(with_bands(start, track, bands)), replace(choice, note=note)
+        resolved = replace(choice, note=note)
     if resolved.source != "estimated":
         return kept(with_bands(start, track, bands)), resolved
     return kept(estimate_again(estimator(resolved), track, bands)), resolved
@@ -198,9 +198,8 @@ def _ruled_out(start: FocalChoice, px: float) -> FocalChoice:
         "is taken"
     )
     meta = start.metadata_px
-    if meta:
-        note += f" ({100 * (px / meta - 1):+.0f}% off the metadata's)"
-    return FocalChoice(px, start.span, "estimated", px, meta, note)
+    off = _off_metadata(px, meta)
+    return FocalChoice(px, start.span, "estimated", px, meta, f"{note} ({off})" if off else note)
 
 
 def _resolved(start: FocalChoice, px: float) -> FocalChoice:
@@ -210,8 +209,15 @@ def _resolved(start: FocalChoice, px: float) -> FocalChoice:
     meta = start.metadata_px
     if meta and abs(px / meta - 1) <= DISAGREES:
         return replace(start, estimated_px=px)
-    note = f"{100 * (px / meta - 1):+.0f}% off the metadata's (a digital zoom?)" if meta else ""
-    return FocalChoice(px, start.span, "estimated", px, meta, note)
+    off = _off_metadata(px, meta)
+    return FocalChoice(
+        px, start.span, "estimated", px, meta, f"{off} (a digital zoom?)" if off else ""
+    )
+
+
+def _off_metadata(px: float, meta: float | None) -> str:
+    """How far ``px`` lies from the metadata's focal length, if any ("" if none)."""
+    return f"{100 * (px / meta - 1):+.0f}% off the metadata's" if meta else ""
 
 
 def focal_from_track(
