@@ -121,8 +121,12 @@ class FocalEstimate:
         is deep enough (``MIN_DEPTH``) for that to mean something."""
         if len(self.costs) < 2 or self.depth < MIN_DEPTH:
             return False
-        reading = np.interp(math.log(focal), np.log(self.focals), self.costs)
-        return bool(reading > (1.0 + REJECT) * self.costs.min())
+        return bool(self.reading(focal) > (1.0 + REJECT) * self.costs.min())
+
+    def reading(self, focal: float | NDArray) -> float | NDArray:
+        """The curve's cost at ``focal`` (px, or an array of them), linear in log f
+        between its candidates."""
+        return np.interp(np.log(focal), np.log(self.focals), self.costs)
 
     def nearest_accepted(self, focal: float) -> float:
         """The focal length nearest ``focal`` (in log f) that the curve reads within
@@ -136,12 +140,12 @@ class FocalEstimate:
         >>> curve.rules_out(700.0), curve.nearest_accepted(700.0)
         (False, 700.0)
         """
-        log_f, top = math.log(focal), (1.0 + ACCEPT) * self.costs.min()
-        if np.interp(log_f, np.log(self.focals), self.costs) <= top:
+        top = (1.0 + ACCEPT) * self.costs.min()
+        if self.reading(focal) <= top:
             return float(focal)
-        grid = np.linspace(*np.log(self.focals[[0, -1]]), 2001)
-        accepted = grid[np.interp(grid, np.log(self.focals), self.costs) <= top]
-        return float(np.exp(accepted[np.argmin(np.abs(accepted - log_f))]))
+        grid = np.geomspace(self.focals[0], self.focals[-1], 2001)
+        accepted = grid[self.reading(grid) <= top]
+        return float(accepted[np.argmin(np.abs(np.log(accepted / focal)))])
 
 
 @njit(cache=True, nogil=True)

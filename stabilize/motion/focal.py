@@ -146,7 +146,7 @@ def estimate_motion(
     auto = choice.source in ("metadata", "default")  # nothing given: estimated
     ws = flow.working_size(info.size)
     start = HoughEstimator(ws.size, choice.px * ws.scale[0], max_deg=settings.max_deg)
-    long_side = max(info.size) * ws.scale[0]  # as the default's 69°, however it is held
+    long_side = choice.span * ws.scale[0]  # as the default's 69°, however it is held
     settled: list[FocalChoice] = []
 
     def estimator(resolved: FocalChoice) -> HoughEstimator:
