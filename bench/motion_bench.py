@@ -44,7 +44,7 @@ from stabilize.video import probe, read_frames
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from real_bench import SHARED, mirrored, walk_options
 
-KARMA = SHARED / "gopro" / "karma.mp4"  # a real distant scene: the rotation alone is exact
+KARMA = SHARED / "gopro" / "karma.mp4"  # a real distant scene: the rotation all but exact
 
 
 def variants(fov: float) -> dict[str, SynthOptions]:
