@@ -88,6 +88,16 @@ def test_a_long_clip_is_voted_once_at_the_focal_length_of_its_start(narrow_walk,
     assert len(kept.samples.u) == 59
 
 
+def phone_view(shared: Path, out: Path, crop: str, crf: int) -> Path:
+    """phone-cc9's real frames cropped to ``crop`` (w:h:x:y) and shown at 640×480, as a
+    phone's digital zoom does, encoded by x264 at ``crf``."""
+    frames = shared / "data" / "phone-cc9" / "frames" / "RE_frame-%d.jpg"
+    cmd = [ffmpeg_exe(), "-v", "error", "-framerate", "30", "-start_number", "99"]
+    view = ["-vf", f"crop={crop},scale=640:480", "-c:v", "libx264", "-crf", str(crf)]
+    subprocess.run([*cmd, "-i", str(frames), *view, "-pix_fmt", "yuv420p", str(out)], check=True)
+    return out
+
+
 @pytest.mark.parametrize("crop", ["320:240:246:189", "240:180:286:219"])  # 31°, 24°
 def test_a_real_narrow_clip_is_estimated(shared, tmp_path, crop):
     # phone-cc9's real frames zoomed in, as a phone's digital zoom does: their middle
@@ -100,11 +110,7 @@ def test_a_real_narrow_clip_is_estimated(shared, tmp_path, crop):
     # grey instead of RGB, the 31° crop read +8.0%; the same 31° crop of
     # an H.264 copy of the frames, encoded twice, read +8%: its curve rose 0.09% two out,
     # which a rule asking for the rise there refused).
-    frames = shared / "data" / "phone-cc9" / "frames" / "RE_frame-%d.jpg"
-    clip = tmp_path / "zoomed.mp4"
-    cmd = [ffmpeg_exe(), "-v", "error", "-framerate", "30", "-start_number", "99"]
-    view = ["-vf", f"crop={crop},scale=640:480", "-c:v", "libx264", "-crf", "12"]
-    subprocess.run([*cmd, "-i", str(frames), *view, "-pix_fmt", "yuv420p", str(clip)], check=True)
+    clip = phone_view(shared, tmp_path / "zoomed.mp4", crop, crf=12)
     _, focal = estimate_motion(clip, probe(clip), Settings())
     assert focal.source == "estimated"
     assert focal.px == pytest.approx(573.85 * 640 / int(crop.split(":")[0]), rel=0.05)
@@ -117,11 +123,7 @@ def test_a_narrow_clip_that_pins_nothing_leaves_the_default_it_rules_out(shared,
     # the 69° default (465.6 px, -49%) 6.2% above its floor, and the nearest it accepts
     # is 852 px (-7%): on a narrow lens the default is the costly side (a rendered 30°
     # clip shook 5.16 px given 69°, 3.25 at 45°, 3.00 at 30°, 3.09 at 15°)
-    frames = shared / "data" / "phone-cc9" / "frames" / "RE_frame-%d.jpg"
-    clip = tmp_path / "zoomed.mp4"
-    cmd = [ffmpeg_exe(), "-v", "error", "-framerate", "30", "-start_number", "99"]
-    view = ["-vf", "crop=400:300:206:159,scale=640:480", "-c:v", "libx264", "-crf", "28"]
-    subprocess.run([*cmd, "-i", str(frames), *view, "-pix_fmt", "yuv420p", str(clip)], check=True)
+    clip = phone_view(shared, tmp_path / "zoomed.mp4", "400:300:206:159", crf=28)
     _, focal = estimate_motion(clip, probe(clip), Settings())
     truth, default = 573.85 * 640 / 400, Settings().focal_px((480, 640))
     assert focal.source == "estimated" and "rules out the default's 69.0°" in focal.note
