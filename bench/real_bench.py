@@ -30,9 +30,18 @@ the tools must exceed to mean anything (max-heromode: ours 0.921–0.988, vid.st
 0.944–1.009; hero7: 1.305–1.335 against 1.118–1.194), and their mean a steadier reading;
 the median ratio is then given of the means too.
 
+``--out-crf`` sets the CRF both tools' output (and the crop) is encoded at (18, as our
+default encodes it). At 0 the encode is lossless and the rows read the geometry alone:
+x264 answers a change of one grey level in a few pixels with other decisions across the
+frame, and the metric follows them. On hero7 two builds whose focal lengths differed by
+5e-13 px (their homographies within 2e-7 of each other) wrote outputs 0.54 grey levels
+apart on average, which read 1.192 and 1.207 px (mirrored means 1.204 and 1.256);
+losslessly both read 1.260 (at the 3 px gate of the time: README).
+
     python bench/real_bench.py                 # the real clips and three rendered walks
     python bench/real_bench.py --fov auto      # our run with the focal length estimated
     python bench/real_bench.py --spread        # with the metric's spread on each output
+    python bench/real_bench.py --out-crf 0     # both outputs lossless: the geometry alone
     python bench/real_bench.py clip.mp4 ...    # other clips
     python bench/real_bench.py --width 640     # each clip scaled down first (640×360)
     python bench/real_bench.py --zoom 2        # each clip's middle half, at its own size
@@ -71,7 +80,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from stabilize_bench import ENCODER, timed, vidstab
+from stabilize_bench import OUT_CRF, encoder, timed, vidstab
 
 from stabilize.evaluate.metrics import evaluate, evaluate_pair
 from stabilize.evaluate.plot import plot_shake
@@ -141,6 +150,9 @@ def main() -> None:
     parser.add_argument("--every", type=int, default=1, help="keep every EVERY-th frame first")
     parser.add_argument("--crf", type=int, default=VIEW_CRF, help="encode each view at this CRF")
     parser.add_argument(
+        "--out-crf", type=int, default=OUT_CRF, help="encode both tools' output at this CRF"
+    )
+    parser.add_argument(
         "--rotation", type=int, default=0, choices=(0, 90, 180, 270), help="tag each view so"
     )
     args = parser.parse_args()
@@ -152,6 +164,8 @@ def main() -> None:
         parser.error("--every must be between 1 and 8")
     if not 0 <= args.crf <= 51:
         parser.error("--crf must be between 0 and 51")
+    if not 0 <= args.out_crf <= 51:
+        parser.error("--out-crf must be between 0 and 51")
     view = View(args.width, args.zoom or 1.0, args.portrait, args.every, args.crf, args.rotation)
     work = Path(tempfile.mkdtemp(prefix="real-bench-"))
     ratios, mean_ratios = [], []
@@ -167,15 +181,18 @@ def main() -> None:
         info = probe(clip)
         mine, theirs = work / f"{tag}_ours.mp4", work / f"{tag}_vidstab.mp4"
         cmd = [sys.executable, "-m", "stabilize.cli", "run", str(clip), str(mine), "-q"]
-        t_ours, _ = timed([*cmd, "--overwrite", *(["--fov", args.fov] if args.fov else [])])
-        t_vs, _ = vidstab(clip, theirs, work)
+        cmd += ["--overwrite", "--crf", str(args.out_crf)]
+        t_ours, _ = timed([*cmd, *(["--fov", args.fov] if args.fov else [])])
+        t_vs, _ = vidstab(clip, theirs, work, args.out_crf)
         fps = info.fps or 30.0
         original, ours_m = evaluate_pair(read_frames(clip), read_frames(mine, info.size), fps)
         _, theirs_m = evaluate_pair(read_frames(clip), read_frames(theirs, info.size), fps)
         for tool, m in (("ours", ours_m), ("vidstab", theirs_m)):  # what each row is the RMS of
             plot_shake(work / f"{tag}_{tool}_shake.png", original, m, fps)
-        cropped = crop_only(clip, work / f"{tag}_crop.mp4", theirs_m.cropping_ratio, info.size)
-        _, crop_m = evaluate_pair(read_frames(clip), read_frames(cropped, info.size), fps)
+        crop = crop_only(
+            clip, work / f"{tag}_crop.mp4", theirs_m.cropping_ratio, info.size, args.out_crf
+        )
+        _, crop_m = evaluate_pair(read_frames(clip), read_frames(crop, info.size), fps)
         for tool, m, t in (
             ("original", original, None),
             ("crop only", crop_m, None),
@@ -252,12 +269,12 @@ def middle(width: int, height: int, ratio: float) -> str:
     return f"crop={cw}:{ch}:{(width - cw) // 2}:{(height - ch) // 2}"
 
 
-def crop_only(clip: Path, dst: Path, ratio: float, size: tuple[int, int]) -> Path:
-    """``clip``'s middle, ``ratio`` of each side, scaled back to ``size`` (h, w) with the
-    bench's encoder: the crop without the stabilisation."""
+def crop_only(clip: Path, dst: Path, ratio: float, size: tuple[int, int], crf: int) -> Path:
+    """``clip``'s middle, ``ratio`` of each side, scaled back to ``size`` (h, w), encoded as
+    both tools' output is (x264 at ``crf``): the crop without the stabilisation."""
     h, w = size
     view = f"{middle(w, h, ratio)},scale={w}:{h}:flags=bicubic"
-    cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-vf", view, *ENCODER, "-an"]
+    cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-vf", view, *encoder(crf), "-an"]
     subprocess.run([*cmd, str(dst)], check=True)
     return dst
 

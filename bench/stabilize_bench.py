@@ -31,7 +31,13 @@ from rotation import so3
 from stabilize.evaluate.metrics import evaluate_pair
 from stabilize.video import ffmpeg_exe, probe, read_frames
 
-ENCODER = ["-c:v", "libx264", "-crf", "18", "-preset", "medium", "-pix_fmt", "yuv420p"]
+OUT_CRF = 18  # both tools' output, as our default encodes it
+
+
+def encoder(crf: int = OUT_CRF) -> list[str]:
+    """FFmpeg's options for both tools' output: libx264 at ``crf`` (0: lossless), preset
+    medium, 4:2:0."""
+    return ["-c:v", "libx264", "-crf", str(crf), "-preset", "medium", "-pix_fmt", "yuv420p"]
 
 
 def timed(cmd: list[str]) -> tuple[float, float]:
@@ -52,13 +58,12 @@ def timed(cmd: list[str]) -> tuple[float, float]:
     return float(dt), float(peak)
 
 
-def vidstab(src: Path, dst: Path, work: Path) -> tuple[float, float]:
+def vidstab(src: Path, dst: Path, work: Path, crf: int = OUT_CRF) -> tuple[float, float]:
     trf = work / "transforms.trf"
     ff = [ffmpeg_exe(), "-hide_banner", "-loglevel", "error", "-y", "-i", str(src)]
     t1, m1 = timed([*ff, "-vf", f"vidstabdetect=result={trf}", "-f", "null", "-"])
-    t2, m2 = timed(
-        [*ff, "-vf", f"vidstabtransform=input={trf}:optzoom=1", *ENCODER, "-c:a", "copy", str(dst)]
-    )
+    transform = ["-vf", f"vidstabtransform=input={trf}:optzoom=1", *encoder(crf)]
+    t2, m2 = timed([*ff, *transform, "-c:a", "copy", str(dst)])
     return t1 + t2, max(m1, m2)
 
 

@@ -62,8 +62,9 @@ MotionOption = Annotated[
     typer.Option(
         help="What the warp compensates: the camera's rotation alone (exact for distant "
         "scenes), or also the image motion it leaves on the background (the vectors "
-        "within 3 px of where the rotation puts them): translation (a walk's sway past "
-        "near surfaces), or similarity (also roll and zoom).",
+        "within about 1% of the frame's long side of where the rotation puts them): "
+        "translation (a walk's sway past near surfaces), or similarity (also roll and "
+        "zoom).",
     ),
 ]
 LockOption = Annotated[bool, typer.Option(help="Hold one orientation, like a tripod.")]

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from rotation import so3
-from stabilize.motion.residual import reexpress, residual_motion
+from stabilize.motion.residual import GATE_PX, reexpress, residual_motion
 
 F = 400.0
 
@@ -31,6 +31,20 @@ def test_a_translation_left_after_the_rotation_is_recovered():
     dx, dy, a, b = residual_motion(x, y, u[None], v[None], valid, R[None], F)[0]
     assert dx * F == pytest.approx(2.0, abs=0.03) and dy * F == pytest.approx(-1.5, abs=0.03)
     assert abs(a) < 1e-4 and abs(b) < 1e-4
+
+
+def test_a_near_wall_passing_4_px_a_frame_is_background():
+    """A walk's sway past a wall that fills the frame: static, so its 4 px a frame (at
+    the flow's size; hero7's near plants loom about 3) is the camera's, to be undone.
+    A 3 px gate left such a pair with no motion at all."""
+    x, y = _grid()
+    R = so3.exp_so3(np.array([0.004, -0.01, 0.0]))
+    u, v = _flow(x, y, R, (4.0, 0.0))
+    rng = np.random.default_rng(1)
+    u, v = u + rng.normal(0, 0.2, u.shape), v + rng.normal(0, 0.2, v.shape)
+    valid = np.ones((1, len(x)), bool)
+    dx, dy, _, _ = residual_motion(x, y, u[None], v[None], valid, R[None], F)[0]
+    assert dx * F == pytest.approx(4.0, abs=0.05) and abs(dy * F) < 0.05
 
 
 def test_a_crowd_moving_across_the_frame_does_not_drag_the_background():
@@ -73,10 +87,10 @@ def test_a_rotation_that_explains_little_of_the_frame_gives_no_zoom_or_roll():
     approach read as the camera's zoom. Where the rotation explains under 40% of the
     frame's vectors, only the translation counts: the camera's zoom here is none."""
     x, y = _grid()
-    R_bird = so3.exp_so3(np.array([0.0, 0.01, 0.0]))
+    R_bird = so3.exp_so3(np.array([0.0, 1.5 * GATE_PX / F, 0.0]))
     bird = np.hypot(x / 300, y / 170) < 0.6
     assert 0.2 < bird.mean() < 0.4
-    u, v = _flow(x, y, np.eye(3), (0.0, 0.0))  # the room: still, 4 px off the bird's turn
+    u, v = _flow(x, y, np.eye(3), (0.0, 0.0))  # the room: still, 1.5 gates off the bird
     u_bird, v_bird = _flow(x, y, R_bird, (0.0, 0.0), scale=0.01)  # it comes 1% closer
     u[bird], v[bird] = u_bird[bird], v_bird[bird]
     valid = np.ones((1, len(x)), bool)
