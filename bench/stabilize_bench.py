@@ -30,8 +30,9 @@ import numpy as np
 from rotation import so3
 from stabilize.evaluate.metrics import evaluate_pair
 from stabilize.video import ffmpeg_exe, probe, read_frames
+from stabilize.video.encoders import DEFAULT_CRF
 
-OUT_CRF = 18  # both tools' output, as our default encodes it
+OUT_CRF = DEFAULT_CRF["libx264"]  # both tools' output, as our default encodes it
 
 
 def encoder(crf: int = OUT_CRF) -> list[str]:
