@@ -23,6 +23,11 @@ expected to read much under its outputs.
     python bench/motion_bench.py
     python bench/motion_bench.py --fov 45 --max-zoom 1.15
     python bench/motion_bench.py --spread          # mirrored means: slower, steadier
+    python bench/motion_bench.py --out-crf 0 --only distant   # the geometry alone
+
+``--out-crf`` sets the CRF every output is encoded at (18, the default's; 0: lossless,
+so that a row reads the warps and not x264's response to them: real_bench's); ``--only``
+keeps the rendered scenes whose names start with one of its words.
 """
 
 from __future__ import annotations
@@ -40,6 +45,8 @@ from stabilize.evaluate.metrics import evaluate, evaluate_pair
 from stabilize.path.residual import MOTION_MODELS
 from stabilize.synth import SynthOptions, render_clip
 from stabilize.video import probe, read_frames
+from stabilize.video.encode import Encoding
+from stabilize.video.encoders import DEFAULT_CRF
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from real_bench import SHARED, mirrored, walk_options
@@ -71,15 +78,17 @@ def shake(clip: Path, out: Path, spread: bool = False) -> tuple[float, float, fl
 
 
 def row(
-    clip: Path, folder: Path, fov: float | None, max_zoom: float, spread: bool
+    clip: Path, folder: Path, fov: float | None, max_zoom: float, spread: bool, crf: int
 ) -> tuple[str, str, str]:
     """The table's cells for ``clip`` stabilised with every ``--motion`` (at ``fov``;
-    None: as a user would run it, the focal length found from the clip): the shake of
-    each, with its ratio to the rotation-only run's, then distortion and crop."""
+    None: as a user would run it, the focal length found from the clip) and encoded at
+    ``crf``: the shake of each, with its ratio to the rotation-only run's, then
+    distortion and crop."""
     readings = []
     for motion in MOTION_MODELS:
         out = folder / f"{motion}.mp4"
-        settings = Settings(motion=motion, fov=fov, max_zoom=max_zoom)
+        encoding = Encoding(crf=crf)
+        settings = Settings(motion=motion, fov=fov, max_zoom=max_zoom, encoding=encoding)
         stabilize_video(clip, out, settings, overwrite=True)
         readings.append(shake(clip, out, spread))
     base = readings[0][0]
@@ -93,24 +102,35 @@ def main() -> None:
     parser.add_argument("--fov", type=float, nargs="+", default=[30.0, 45.0, 100.0])
     parser.add_argument("--max-zoom", type=float, default=1.5)
     parser.add_argument("--spread", action="store_true", help="mean of four mirrored readings")
+    parser.add_argument(
+        "--out-crf", type=int, default=DEFAULT_CRF["libx264"], help="encode outputs at this CRF"
+    )
+    parser.add_argument("--only", nargs="+", help="keep the scenes named so (e.g. distant)")
     args = parser.parse_args()
+    if not 0 <= args.out_crf <= 51:
+        parser.error("--out-crf must be between 0 and 51")
     work = Path(tempfile.mkdtemp(prefix="motion-bench-"))
     motions = list(MOTION_MODELS)
-    print(f"clips and outputs in {work}; --max-zoom {args.max_zoom}, true field of view")
+    print(f"clips and outputs in {work}; --max-zoom {args.max_zoom}, true field of view,")
+    print(f"outputs at CRF {args.out_crf}")
     print("| walk | clip | original | " + " | ".join(motions) + " | distortion | crop |")
     print("|---|---|---|" + "---|" * (len(motions) + 2))
     for fov in args.fov:
         for name, opts in variants(fov).items():
+            if args.only and not any(name.startswith(word) for word in args.only):
+                continue
             folder = work / f"{int(fov)}-{name.split()[0]}"
             render_clip(folder, opts)
             clip = folder / "clip.mp4"
-            cells, dist, crop = row(clip, folder, fov, args.max_zoom, args.spread)
+            cells, dist, crop = row(clip, folder, fov, args.max_zoom, args.spread, args.out_crf)
             original = evaluate(read_frames(clip), opts.fps).residual_shake_px
             print(f"| {fov:g}° | {name} | {original:.3f} | {cells} | {dist} | {crop} |")
-    if KARMA.is_file():  # as a user's run: its field of view found from it, the default budget
+    # karma as a user's run: its field of view found from it, the default budget
+    if KARMA.is_file() and (not args.only or "karma" in args.only):
         folder = work / "karma"
         folder.mkdir()
-        cells, dist, crop = row(KARMA, folder, None, Settings().max_zoom, args.spread)
+        zoom = Settings().max_zoom
+        cells, dist, crop = row(KARMA, folder, None, zoom, args.spread, args.out_crf)
         original = evaluate(read_frames(KARMA), probe(KARMA).fps).residual_shake_px
         print(f"| real | karma (distant) | {original:.3f} | {cells} | {dist} | {crop} |")
 
