@@ -82,7 +82,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from stabilize_bench import OUT_CRF, encoder, timed, vidstab
 
-from stabilize.evaluate.metrics import evaluate, evaluate_pair
+from stabilize.evaluate.metrics import evaluate, evaluate_against, evaluate_pair
 from stabilize.evaluate.plot import plot_shake
 from stabilize.video import ffmpeg_exe, probe, read_frames
 
@@ -185,8 +185,8 @@ def main() -> None:
         t_ours, _ = timed([*cmd, *(["--fov", args.fov] if args.fov else [])])
         t_vs, _ = vidstab(clip, theirs, work, args.out_crf)
         fps = info.fps or 30.0
-        original, ours_m = evaluate_pair(read_frames(clip), read_frames(mine, info.size), fps)
-        _, theirs_m = evaluate_pair(read_frames(clip), read_frames(theirs, info.size), fps)
+        outputs = [read_frames(mine, info.size), read_frames(theirs, info.size)]
+        original, (ours_m, theirs_m) = evaluate_against(read_frames(clip), outputs, fps)
         for tool, m in (("ours", ours_m), ("vidstab", theirs_m)):  # what each row is the RMS of
             plot_shake(work / f"{tag}_{tool}_shake.png", original, m, fps)
         crop = crop_only(

@@ -23,7 +23,7 @@ counted).
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import asdict, dataclass, field
 
 import cv2
@@ -267,18 +267,35 @@ def evaluate_pair(
     Frames are taken in step; if one clip is longer, its extra frames are ignored.
     For the original, cropping ratio and distortion are 1 by definition.
     """
-    before, after = _Clip(), _Clip()
-    scales, ratios = [], []
-    for orig, stab in zip(original, stabilised, strict=False):
-        feat_orig, feat_stab = before.add(orig), after.add(stab)
-        # Stabilised → original: a zoomed-in output registers with scale < 1.
-        H = after.reg.homography(feat_stab, feat_orig, stab.shape[1])
-        center = ((stab.shape[1] - 1) / 2, (stab.shape[0] - 1) / 2)
-        scale, ratio = scale_and_distortion(H, center)
-        scales.append(scale)
-        ratios.append(ratio)
+    before, (after,) = evaluate_against(original, [stabilised], fps, progress)
+    return before, after
+
+
+def evaluate_against(
+    original: Iterable[NDArray[np.uint8]],
+    outputs: Sequence[Iterable[NDArray[np.uint8]]],
+    fps: float = 30.0,
+    progress: Progress = no_progress,
+) -> tuple[ClipMetrics, list[ClipMetrics]]:
+    """Metrics of the original and of each of several outputs of it (two tools', say),
+    in one pass that reads the original once; each output's are those
+    :func:`evaluate_pair` gives it. Frames are taken in step; the shortest clip decides."""
+    before, afters = _Clip(), [_Clip() for _ in outputs]
+    scales: list[list[float]] = [[] for _ in outputs]
+    ratios: list[list[float]] = [[] for _ in outputs]
+    for orig, *stabs in zip(original, *outputs, strict=False):
+        feat_orig = before.add(orig)
+        for after, stab, scale_k, ratio_k in zip(afters, stabs, scales, ratios, strict=True):
+            feat_stab = after.add(stab)
+            # Stabilised → original: a zoomed-in output registers with scale < 1.
+            H = after.reg.homography(feat_stab, feat_orig, stab.shape[1])
+            center = ((stab.shape[1] - 1) / 2, (stab.shape[0] - 1) / 2)
+            scale, ratio = scale_and_distortion(H, center)
+            scale_k.append(scale)
+            ratio_k.append(ratio)
         progress(1)
-    return before.metrics([], [], fps), after.metrics(scales, ratios, fps)
+    mine = [a.metrics(s, r, fps) for a, s, r in zip(afters, scales, ratios, strict=True)]
+    return before.metrics([], [], fps), mine
 
 
 def evaluate(frames: Iterable[NDArray[np.uint8]], fps: float = 30.0) -> ClipMetrics:

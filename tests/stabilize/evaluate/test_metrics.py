@@ -4,6 +4,7 @@ import pytest
 
 from stabilize.evaluate.metrics import (
     evaluate,
+    evaluate_against,
     evaluate_pair,
     low_frequency_share,
     scale_and_distortion,
@@ -58,6 +59,20 @@ def test_a_zoomed_crop_ranks_below_an_uncropped_one(shaken):
     assert same.cropping_ratio == pytest.approx(1.0, abs=0.01)
     assert cropped.cropping_ratio == pytest.approx(0.8, abs=0.02)
     assert cropped.distortion > 0.97
+
+
+def test_several_outputs_read_against_one_original_as_each_alone(shaken):
+    # the benches read two tools' outputs in one pass over the original
+    steadier = [shaken[0]] * len(shaken)
+    zoomed = [f[8:-8, 16:-16] for f in shaken]
+    zoomed = [cv2.resize(f, (shaken[0].shape[1], shaken[0].shape[0])) for f in zoomed]
+    before, (a, b) = evaluate_against(shaken, [steadier, zoomed])
+    alone_a, alone_b = evaluate_pair(shaken, steadier)[1], evaluate_pair(shaken, zoomed)[1]
+    assert before.residual_shake_px == evaluate(shaken).residual_shake_px
+    for m, alone in ((a, alone_a), (b, alone_b)):
+        assert m.residual_shake_px == alone.residual_shake_px
+        assert (m.cropping_ratio, m.distortion) == (alone.cropping_ratio, alone.distortion)
+    assert a.residual_shake_px < 0.1 < b.residual_shake_px and b.cropping_ratio < 0.95
 
 
 def test_metric_building_blocks():
