@@ -41,7 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from stabilize import Settings, stabilize_video
-from stabilize.evaluate.metrics import evaluate, evaluate_pair
+from stabilize.evaluate.metrics import evaluate, evaluate_against
 from stabilize.path.residual import MOTION_MODELS
 from stabilize.synth import SynthOptions, render_clip
 from stabilize.video import probe, read_frames
@@ -50,6 +50,7 @@ from stabilize.video.encoders import DEFAULT_CRF
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from real_bench import SHARED, mirrored, walk_options
+from stabilize_bench import crf_option
 
 KARMA = SHARED / "gopro" / "karma.mp4"  # a real distant scene: the rotation all but exact
 
@@ -66,15 +67,20 @@ def variants(fov: float) -> dict[str, SynthOptions]:
     }
 
 
-def shake(clip: Path, out: Path, spread: bool = False) -> tuple[float, float, float]:
-    """(residual shake px, distortion, crop) of ``out``, stabilised from ``clip``; with
-    ``spread``, the shake is the mean of its four mirrored readings."""
+def shakes(clip: Path, outs: list[Path], spread: bool = False) -> list[tuple[float, float, float]]:
+    """(residual shake px, distortion, crop) of each of ``outs``, stabilised from ``clip``
+    and read in one pass over it; with ``spread``, the shake is the mean of its four
+    mirrored readings."""
     info = probe(clip)
-    _, metrics = evaluate_pair(read_frames(clip), read_frames(out, info.size), info.fps)
-    px = metrics.residual_shake_px
-    if spread:
-        px = float(np.mean(mirrored(out, info.size, info.fps, metrics)))
-    return px, metrics.distortion, metrics.cropping_ratio
+    outputs = [read_frames(out, info.size) for out in outs]
+    _, found = evaluate_against(read_frames(clip), outputs, info.fps)
+    readings = []
+    for out, metrics in zip(outs, found, strict=True):
+        px = metrics.residual_shake_px
+        if spread:
+            px = float(np.mean(mirrored(out, info.size, info.fps, metrics)))
+        readings.append((px, metrics.distortion, metrics.cropping_ratio))
+    return readings
 
 
 def row(
@@ -84,13 +90,12 @@ def row(
     None: as a user would run it, the focal length found from the clip) and encoded at
     ``crf``: the shake of each, with its ratio to the rotation-only run's, then
     distortion and crop."""
-    readings = []
-    for motion in MOTION_MODELS:
-        out = folder / f"{motion}.mp4"
-        encoding = Encoding(crf=crf)
+    encoding = Encoding(crf=crf)
+    outs = [folder / f"{motion}.mp4" for motion in MOTION_MODELS]
+    for motion, out in zip(MOTION_MODELS, outs, strict=True):
         settings = Settings(motion=motion, fov=fov, max_zoom=max_zoom, encoding=encoding)
         stabilize_video(clip, out, settings, overwrite=True)
-        readings.append(shake(clip, out, spread))
+    readings = shakes(clip, outs, spread)
     base = readings[0][0]
     cells = " | ".join(f"{r[0]:.3f} ({r[0] / base:.2f})" for r in readings)
     dist = " / ".join(f"{r[1]:.3f}" for r in readings)
@@ -103,12 +108,13 @@ def main() -> None:
     parser.add_argument("--max-zoom", type=float, default=1.5)
     parser.add_argument("--spread", action="store_true", help="mean of four mirrored readings")
     parser.add_argument(
-        "--out-crf", type=int, default=DEFAULT_CRF["libx264"], help="encode outputs at this CRF"
+        "--out-crf",
+        type=crf_option,
+        default=DEFAULT_CRF["libx264"],
+        help="encode outputs at this CRF",
     )
     parser.add_argument("--only", nargs="+", help="keep the scenes named so (e.g. distant)")
     args = parser.parse_args()
-    if not 0 <= args.out_crf <= 51:
-        parser.error("--out-crf must be between 0 and 51")
     work = Path(tempfile.mkdtemp(prefix="motion-bench-"))
     motions = list(MOTION_MODELS)
     print(f"clips and outputs in {work}; --max-zoom {args.max_zoom}, true field of view,")

@@ -80,7 +80,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from stabilize_bench import OUT_CRF, encoder, timed, vidstab
+from stabilize_bench import OUT_CRF, crf_option, encoder, timed, vidstab
 
 from stabilize.evaluate.metrics import evaluate, evaluate_against, evaluate_pair
 from stabilize.evaluate.plot import plot_shake
@@ -148,9 +148,11 @@ def main() -> None:
         "--portrait", action="store_true", help="keep each clip's middle 9:16 first (upright)"
     )
     parser.add_argument("--every", type=int, default=1, help="keep every EVERY-th frame first")
-    parser.add_argument("--crf", type=int, default=VIEW_CRF, help="encode each view at this CRF")
     parser.add_argument(
-        "--out-crf", type=int, default=OUT_CRF, help="encode both tools' output at this CRF"
+        "--crf", type=crf_option, default=VIEW_CRF, help="encode each view at this CRF"
+    )
+    parser.add_argument(
+        "--out-crf", type=crf_option, default=OUT_CRF, help="encode both tools' output at this CRF"
     )
     parser.add_argument(
         "--rotation", type=int, default=0, choices=(0, 90, 180, 270), help="tag each view so"
@@ -162,10 +164,6 @@ def main() -> None:
         parser.error("--zoom must be between 1 and 8")
     if not 1 <= args.every <= 8:
         parser.error("--every must be between 1 and 8")
-    if not 0 <= args.crf <= 51:
-        parser.error("--crf must be between 0 and 51")
-    if not 0 <= args.out_crf <= 51:
-        parser.error("--out-crf must be between 0 and 51")
     view = View(args.width, args.zoom or 1.0, args.portrait, args.every, args.crf, args.rotation)
     work = Path(tempfile.mkdtemp(prefix="real-bench-"))
     ratios, mean_ratios = [], []

@@ -35,6 +35,14 @@ from stabilize.video.encoders import DEFAULT_CRF
 OUT_CRF = DEFAULT_CRF["libx264"]  # both tools' output, as our default encodes it
 
 
+def crf_option(text: str) -> int:
+    """An x264 CRF as a command line gives it (argparse's ``type``): 0 to 51."""
+    value = int(text)
+    if not 0 <= value <= 51:
+        raise argparse.ArgumentTypeError(f"must be between 0 and 51, got {value}")
+    return value
+
+
 def encoder(crf: int = OUT_CRF) -> list[str]:
     """FFmpeg's options for both tools' output: libx264 at ``crf`` (0: lossless), preset
     medium, 4:2:0."""
