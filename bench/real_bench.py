@@ -36,7 +36,7 @@ x264 answers a change of one grey level in a few pixels with other decisions acr
 frame, and the metric follows them. On hero7 two builds whose focal lengths differed by
 5e-13 px (their homographies within 2e-7 of each other) wrote outputs 0.54 grey levels
 apart on average, which read 1.192 and 1.207 px (mirrored means 1.204 and 1.256);
-losslessly both read 1.260 (at the 3 px gate of the time: README).
+losslessly both read 1.260 (at the 3 px gate of the time: docs/focal-length.md).
 
     python bench/real_bench.py                 # the real clips and three rendered walks
     python bench/real_bench.py --fov auto      # our run with the focal length estimated
@@ -52,7 +52,7 @@ losslessly both read 1.260 (at the 3 px gate of the time: README).
 
 ``--width`` scales every clip down (FFmpeg, bicubic, CRF 14, limited range) before either
 tool sees it: the literature's "Regular" clips are 640×360, and there the lead is
-smaller (README). ``--zoom`` keeps the middle 1/Z of each side instead, scaled back to
+smaller (docs/real-footage.md). ``--zoom`` keeps the middle 1/Z of each side instead, scaled back to
 the clip's size (or to ``--width``), as a digital zoom does: a narrower field of view
 that no tool is told, where a wrong focal length shows most. ``--portrait`` keeps each
 clip's middle 9:16 of its height first: a clip shot upright and stored upright (an
