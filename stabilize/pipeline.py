@@ -46,6 +46,7 @@ from stabilize.settings import Settings
 from stabilize.video import VideoInfo, atomic_output, frame_interval, frame_times, probe
 from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Mux
+from stabilize.video.fields import DEINTERLACE_MODES
 from stabilize.video.preflight import check_encoder, check_writable, describe
 from stabilize.video.streams import keep_streams
 from stabilize.warp.camera_path import CameraPath
@@ -118,6 +119,8 @@ def stabilize_video(
         "size": list(job.info.shown_size[::-1]),  # as shown
         # counter-clockwise, degrees: the report's axes and pixels are the stored frames'
         "display_rotation": job.info.rotation,
+        "field_order": job.info.field_order or None,  # the input's: tff, bff, progressive
+        "deinterlaced": job.info.deinterlace,
         "focal_px": float(K[0, 0]),
         "focal": focal.summary(),
         "zoom": float(planned.zoom.max()),
@@ -152,7 +155,8 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
         from stabilize.gyro.load import load_gyro
 
         log = load_gyro(settings)
-    info = probe(src).stored()  # the sensor's rows, whichever way the camera was held
+    # the sensor's rows, whichever way the camera was held; its fields woven into frames
+    info = probe(src).stored().deinterlaced(settings.deinterlace)
     check_writable(dst)
     check_encoder(dst, settings.encoding, encoded_size(info, settings))
     lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
@@ -163,7 +167,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
 
         stamps = sensor_frame_times(settings.gyro_timestamps, 0, len(times))
     mux = keep_streams(info, container_for(dst), info.video_delay)
-    notices = mux.notices
+    notices = mux.notices + fields_notice(info)
     if not settings.size and frame_size(info, settings) != info.shown_size:
         (h, w), (sh, sw) = frame_size(info, settings), info.shown_size
         notices += (
@@ -171,6 +175,18 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
             "cropped (4:2:0 video needs even sides)",
         )
     return Job(info, times, lens, log, stamps, mux, notices)
+
+
+def fields_notice(info: VideoInfo) -> tuple[str, ...]:
+    """A notice where the frames are deinterlaced, or where an interlaced stream is not
+    (``--deinterlace off``: the warp then blends its fields into combs)."""
+    order = {"tff": "top field first", "bff": "bottom field first"}.get(info.field_order)
+    if info.deinterlace:
+        what = f"interlaced ({order})" if order else "flagged progressive"
+        return (f"{what}: each frame deinterlaced (FFmpeg's bwdif); the output is progressive",)
+    if order:
+        return (f"interlaced ({order}), left so (--deinterlace off): the warp blends its fields",)
+    return ()
 
 
 def compiling_notice() -> tuple[str, ...]:
@@ -295,6 +311,10 @@ def check_settings(settings: Settings) -> None:
             f"--motion must be one of {', '.join(MOTION_MODELS)}",
         ),
         (settings.device in ("cpu", "cuda"), "--device must be cpu or cuda"),
+        (
+            settings.deinterlace in DEINTERLACE_MODES,
+            f"--deinterlace must be one of {', '.join(DEINTERLACE_MODES)}",
+        ),
         (
             settings.fov in (None, "auto")
             or (isinstance(settings.fov, int | float) and 0 < settings.fov < 180),

@@ -71,6 +71,9 @@ class Settings:
     lens: str | None = None  # a Gyroflow lens profile (OpenCV fisheye)
     device: str = "cpu"  # where frames are warped: cpu (OpenCV) or cuda (kornia, batched)
     size: tuple[int, int] | None = None  # output (H, W); default: the input's
+    # interlaced input (stabilize.video.fields): 'auto' deinterlaces a stream flagged
+    # interlaced, 'on' every stream (one flagged progressive but combed), 'off' none
+    deinterlace: str = "auto"
     encoding: Encoding = field(default_factory=Encoding)
 
     def focal_px(self, size: tuple[int, int]) -> float:

@@ -25,6 +25,7 @@ from stabilize.path.smoothing import METHODS
 from stabilize.path.zoom import CROP_MODES
 from stabilize.settings import DEFAULTS, Settings
 from stabilize.video.encode import Encoding
+from stabilize.video.fields import DEINTERLACE_MODES
 
 FlowOption = Annotated[
     Literal[tuple(flow.BACKENDS)],
@@ -94,6 +95,13 @@ CrfOption = Annotated[
     ),
 ]
 PresetOption = Annotated[str, typer.Option(help="Encoder speed preset (x264's names).")]
+DeinterlaceOption = Annotated[
+    Literal[DEINTERLACE_MODES],
+    typer.Option(
+        help="Interlaced video (a camcorder's 50i, 60i): auto deinterlaces a stream flagged "
+        "interlaced, on every stream (one flagged progressive but combed), off none."
+    ),
+]
 PreviewOption = Annotated[
     Literal["none", "side-by-side"],
     typer.Option(help="side-by-side: the original and the stabilised clip next to each other."),
@@ -196,6 +204,7 @@ def job_settings(params: Mapping[str, Any]) -> Settings:
         crop=params["crop"],
         preview=preview == "side-by-side",
         size=output_size(params["size"]),
+        deinterlace=params.get("deinterlace", DEFAULTS.deinterlace),
         encoding=Encoding(codec=params["codec"], crf=params["crf"], preset=params["preset"]),
         gyro=str(gyro) if gyro and gyro != "auto" else None,
         gyro_lpf=params["gyro_lpf"],

@@ -15,6 +15,7 @@ from stabilize.cli.options import (
     CodecOption,
     CrfOption,
     CropOption,
+    DeinterlaceOption,
     DeviceOption,
     FlowOption,
     FocalOption,
@@ -83,6 +84,7 @@ def run(
     ),
     preview: PreviewOption = NO_PREVIEW,
     size: SizeOption = None,
+    deinterlace: DeinterlaceOption = DEFAULTS.deinterlace,
     gyro: Path | None = typer.Option(
         None, help="Stabilise from this gyro log (synchronised to the video) instead."
     ),

@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stabilize.video.binary import ffmpeg_exe, widen_pipe
+from stabilize.video.fields import deinterlace_filter, interlaced
 from stabilize.video.i420 import pipe_layout
 from stabilize.video.probe import VideoError, VideoInfo, probe
 
@@ -28,8 +29,10 @@ def read_frames(
     ``"yuv420p10le"`` 10-bit ones (uint16).
 
     FFmpeg applies the display rotation, so frames come upright, unless ``info`` is
-    :meth:`VideoInfo.stored`: they then come as the sensor stored them. A stream that ends
-    early or breaks raises :class:`VideoError` after the frames that did decode.
+    :meth:`VideoInfo.stored`: they then come as the sensor stored them. An interlaced
+    stream's frames come deinterlaced, one for each frame, unless ``info`` is
+    :meth:`VideoInfo.deinterlaced` ``("off")`` (:mod:`stabilize.video.fields`). A stream
+    that ends early or breaks raises :class:`VideoError` after the frames that did decode.
     """
     info = info or probe(path)
     h, w = size or info.size
@@ -43,6 +46,9 @@ def read_frames(
         # it makes the decode about 20% faster.
         options["skip_loop_filter"] = "all"
     stream = ffmpeg.input(str(path), **options)
+    if info.deinterlace:  # before any scaling, which would blend the fields
+        name, fields = deinterlace_filter(every_frame=not interlaced(info.field_order))
+        stream = stream.filter(name, **fields)
     if shrink:
         stream = stream.filter("scale", w, h, flags="area")
     process = (

@@ -13,6 +13,12 @@ from pathlib import Path
 
 from stabilize.video.binary import ffmpeg_exe
 from stabilize.video.colour import UNKNOWN, Colour, colour_of
+from stabilize.video.fields import (
+    DEINTERLACE_MODES,
+    field_order,
+    first_frame_field_order,
+    interlaced,
+)
 
 
 class VideoError(ValueError):
@@ -53,6 +59,8 @@ class VideoInfo:
     metadata: str = ""  # the file's own tags as FFmpeg lists them (before its streams)
     colour: Colour = UNKNOWN  # range, matrix, primaries, transfer: kept in the output
     autorotate: bool = True  # whether FFmpeg turns the frames by the display rotation
+    field_order: str = ""  # "progressive", "tff", "bff", or "" where FFmpeg names none
+    deinterlace: bool = False  # whether frames are deinterlaced on decoding (bwdif)
 
     @property
     def size(self) -> tuple[int, int]:
@@ -88,13 +96,26 @@ class VideoInfo:
             return 0.0
         return max(video.start - self.start, 0.0)
 
+    def deinterlaced(self, mode: str = "auto") -> VideoInfo:
+        """The video as it will be decoded under ``--deinterlace`` ``mode``
+        (:mod:`stabilize.video.fields`): ``auto`` deinterlaces a stream whose field order
+        says it is interlaced (what :func:`probe` sets), ``on`` every stream (one flagged
+        progressive but combed), ``off`` none."""
+        if mode not in DEINTERLACE_MODES:
+            raise ValueError(f"--deinterlace must be one of {', '.join(DEINTERLACE_MODES)}")
+        every = {"auto": interlaced(self.field_order), "on": True, "off": False}[mode]
+        return replace(self, deinterlace=every)
+
     def of_kind(self, kind: str) -> tuple[Stream, ...]:
         """The streams of one kind ("audio", "subtitle", ...), in the file's order."""
         return tuple(s for s in self.streams if s.kind == kind)
 
 
+# the pixel format's details may hold parentheses of their own: "(tv, top coded first
+# (swapped))"
 _VIDEO = re.compile(
-    r"Stream #\S+.*?: Video: (\w+).*?, (\w+)(?:\(([^)]*)\))?, .*?(\d{2,5})x(\d{2,5})"
+    r"Stream #\S+.*?: Video: (\w+).*?, (\w+)(?:\(((?:[^()]|\([^()]*\))*)\))?, "
+    r".*?(\d{2,5})x(\d{2,5})"
 )
 _FPS = re.compile(r"(\d+(?:\.\d+)?) (?:fps|tbr)")
 _DURATION = re.compile(r"Duration: (\d+):(\d+):(\d+(?:\.\d+)?)")
@@ -123,6 +144,12 @@ def _stream(match: re.Match, text: str) -> Stream:
         title.group(1).strip() if title else "",
         timecode.group(1) if timecode else "",
     )
+
+
+def _field_order(path: Path, input_args: tuple, details: str) -> str:
+    """The stream's field order as its header names it, else as its first frame is
+    flagged (:mod:`stabilize.video.fields`)."""
+    return field_order(details) or first_frame_field_order(path, input_args)
 
 
 def sequence_args(path: str | Path, start_number: int | None, fps: float | None) -> tuple:
@@ -188,4 +215,6 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
         len(re.findall(r"^\s+Chapter #", text, re.M)),
         text[: text.find("Stream #")],
         colour_of(pix_fmt, video.group(3) or ""),
+        field_order=(order := _field_order(path, input_args, video.group(3) or "")),
+        deinterlace=interlaced(order),
     )

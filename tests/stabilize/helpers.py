@@ -30,6 +30,29 @@ def held_upright(clip: Path, folder: Path, rotation: int = 90) -> Path:
     return rotated
 
 
+def woven(clip: Path, folder: Path) -> Path:
+    """``clip``'s frames woven in pairs into the two fields of one frame (top field
+    first), an interlaced H.264 stream at half the rate, as a camcorder's 50i stores a
+    50 fps scene."""
+    out = folder / "woven.mp4"
+    weave = ["-vf", "tinterlace=mode=interleave_top,setfield=tff", "-flags", "+ildct+ilme"]
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(clip), *weave, "-x264opts", "tff=1"]
+    subprocess.run([*cmd, "-c:v", "libx264", "-crf", "14", "-c:a", "copy", str(out)], check=True)
+    return out
+
+
+def combing(frame: NDArray) -> float:
+    """How combed a frame's grey levels are: the mean of |row − the mean of its two
+    neighbours| over that of |row above − row below|. Where the fields of a moving scene
+    are woven, each row differs from both neighbours (a rendered 320×180 street shaken
+    1.5°: about 1.3); a progressive frame's rows lie between theirs (about 0.5)."""
+    y = frame.astype(np.float32)
+    if y.ndim == 3:
+        y = y.mean(axis=2)
+    teeth = np.abs(y[1:-1] - (y[:-2] + y[2:]) / 2).mean()
+    return float(teeth / (np.abs(y[:-2] - y[2:]).mean() + 1e-6))
+
+
 def covers(K, C, zoom, size, rows=None, lens: Lens | None = None) -> bool:
     """Whether one frame's output at ``zoom`` lies inside its warped input."""
     return bool(Framing(K, size, rows, lens).covered(np.asarray(C)[None], np.array([zoom]))[0])

@@ -62,6 +62,7 @@ CASES = {
     "crop": Case(("--crop", "foo"), 2),
     "device": Case(("--device", "gpu"), 2),
     "preview": Case(("--preview", "stacked"), 2),
+    "deinterlace": Case(("--deinterlace", "sideways"), 2),
     "fov zero": Case(("--fov", "0"), 2),
     "fov 200": Case(("--fov", "200"), 2),
     "focal negative": Case(("--focal", "-5"), 2),
@@ -113,6 +114,7 @@ CASES = {
     "VP9 WebM input": Case((), 0, early=False, source="vp9.webm", container="mp4"),
     "ProRes MOV input": Case((), 0, early=False, source="prores.mov", container="mp4"),
     "AV1 input": Case((), 0, early=False, source="av1.mkv", container="mp4"),
+    "interlaced MPEG-2 TS input": Case((), 0, early=False, source="50i.ts", container="mp4"),
 }
 if shutil.which("nvidia-smi"):  # pragma: no cover - a machine with a GPU runs it
     CASES.pop("cuda without a GPU")
@@ -129,6 +131,11 @@ TRANSCODES = {
     "av1.mkv": ["-c:v", "libsvtav1", "-preset", "12", "-c:a", "copy"],
     "odd": ["-vf", "crop=319:179:0:0", "-c:v", "libx264", "-pix_fmt", "yuv444p", "-c:a", "copy"],
     "one frame": ["-frames:v", "1", "-an"],
+    # a broadcast or camcorder recording: MPEG-2, fields woven top first
+    "50i.ts": [
+        *("-vf", "tinterlace=mode=interleave_top,setfield=tff", "-flags", "+ildct+ilme"),
+        *("-c:v", "mpeg2video", "-q:v", "3", "-c:a", "mp2", "-f", "mpegts"),
+    ],
 }
 
 
