@@ -6,7 +6,9 @@ angular error of each pair is θ(R_vis R_gyroᵀ); the AAE is their mean, as in 
 
 A loud warning is raised, never a silent success, when the two disagree too much to be
 trusted: the angular speeds barely correlate (a wrong log, or a clip stabilised in the
-camera), or the error is a large share of the motion itself.
+camera); the video turns far less or far more than its gyro (a clip stabilised in the
+camera whose speeds still correlate, a log read in the wrong unit); or the error is a
+large share of the motion itself.
 """
 
 from __future__ import annotations
@@ -33,6 +35,13 @@ from stabilize.video import VideoInfo
 from stabilize.warp.lens import Lens
 
 MAX_ERROR_SHARE = 1.0  # AAE over the mean rotation per frame: the estimate says nothing
+# The video's turn over the gyro's (Comparison.motion_scale) outside which the two do not
+# measure the same motion. A matched log reads about 1: karma 0.88 at the 69° default
+# (pitch and yaw scale with f_true/f, and its lens is wider), the rendered sample 1.00.
+# In-camera stabilisation turns the video far less than its gyro: max-heromode 0.17 (its
+# speeds still correlate at 0.90, so the correlation check passes it), hero7 0.02. A log
+# of degrees read as radians, or the other way, reads 57 times off.
+MOTION_SCALE = (0.5, 2.0)
 FOCAL_ROUNDS = 3  # re-estimations when fitting the focal length to the gyro
 FOCAL_CONVERGED = 0.005  # a relative change of the fitted focal length below which it stops
 
@@ -58,6 +67,13 @@ class Comparison:
         """Mean |error| about each camera axis (pitch x, yaw y, roll z), degrees."""
         return np.degrees(np.abs(so3.log_so3(self.visual @ np.swapaxes(self.gyro, -1, -2)))).mean(0)
 
+    def motion_scale(self) -> float:
+        """How far the video turns for each radian its gyro turns: the least-squares
+        scale of the visual rotation vectors on the gyro's, Σ v·g / Σ g·g (about 1 for
+        a matched log; see ``MOTION_SCALE``)."""
+        v, g = so3.log_so3(self.visual), so3.log_so3(self.gyro)
+        return float(np.sum(v * g) / max(np.sum(g * g), 1e-300))
+
     def warning(self) -> str | None:
         motion = np.degrees(so3.angle(self.gyro)).mean()
         aae = self.errors_deg.mean()
@@ -66,6 +82,20 @@ class Comparison:
                 f"visual and gyro motion barely agree (speed correlation "
                 f"{self.sync.correlation:.2f} < {MIN_CORRELATION}): a wrong or mismatched log, "
                 "or a clip stabilised in the camera. Do not trust these figures."
+            )
+        scale = self.motion_scale()
+        if scale < MOTION_SCALE[0]:
+            return (
+                f"the video turns only {100 * scale:.0f}% as much as its gyro (least-squares "
+                "scale): a clip stabilised in the camera, whose gyro records the shake it "
+                "took out, or a focal length far off (--calibrate-focal). Do not trust these "
+                "figures."
+            )
+        if scale > MOTION_SCALE[1]:
+            return (
+                f"the video turns {scale:.1f} times as much as its gyro (least-squares scale): "
+                "a log in another unit (degrees read as radians?), or a focal length far off. "
+                "Do not trust these figures."
             )
         if aae > MAX_ERROR_SHARE * motion:
             return (
@@ -95,6 +125,7 @@ class Comparison:
             "axes": axes_code(self.sync.R_cam_imu),
             "gyro_bias_rad_s": self.sync.bias.tolist(),
             "speed_correlation": self.sync.correlation,
+            "motion_scale": self.motion_scale(),
             "focal_px": self.focal_px,
             "gyro_rate_hz": self.gyro_rate_hz,
             "warning": self.warning(),

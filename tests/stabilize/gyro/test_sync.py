@@ -80,6 +80,7 @@ def test_compare_command_on_a_rendered_clip(tmp_path):
     assert abs(summary["offset_s"] - meta["offset_s"]) < 1e-3
     assert summary["axes"] == "YXz" and summary["warning"] is None
     assert summary["aae_deg"] < 0.06 and summary["frames"] == 89
+    assert abs(summary["motion_scale"] - 1) < 0.05  # the video turns as its gyro does
     for name in ("pairs.csv", "summary.json", "rates.png", "error.png", "histogram.png"):
         assert (tmp_path / name).is_file()
 
@@ -103,6 +104,26 @@ def test_a_wrong_log_raises_the_warning(tmp_path, sample):
     assert "WARNING" in result.output
     start = result.output.index("{")
     assert json.loads(result.output[start:])["warning"]
+
+
+def test_a_log_in_the_wrong_unit_raises_the_warning(tmp_path, sample):
+    # degrees per second where the format says radians: the speeds correlate as well as
+    # ever, the error is as large as the motion (so neither check fired), and the video
+    # turns 1/57 as much as the log says
+    _, _, _, log = sample
+    path = tmp_path / "degrees.csv"
+    path.write_text(
+        "".join(
+            f"{x},{y},{z},{round(t * 1e9)}\n"
+            for (x, y, z), t in zip(np.degrees(log.rates), log.times, strict=True)
+        )
+    )
+    args = ["compare", str(SAMPLE / "clip.mp4"), "--gyro", str(path), "--fov", "70", "-q"]
+    result = CliRunner().invoke(app, [*args, "--json"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.output[result.output.index("{") :])
+    assert summary["speed_correlation"] > 0.6 and summary["motion_scale"] < 0.03
+    assert "turns only 2% as much as its gyro" in summary["warning"]
 
 
 def test_a_log_that_cannot_cover_the_video_is_an_error(tmp_path):
@@ -170,6 +191,7 @@ def test_phone_cc9_offset_axes_and_readout(shared):
     assert 10.0 < summary["readout_ms"] < 33.4
     # 0.057° with only textured vectors voting, 0.090° with every vector (flow.texture)
     assert summary["aae_deg"] < 0.07 and summary["warning"] is None
+    assert 0.9 < summary["motion_scale"] < 1.1
 
 
 def test_a_linear_clock_drift_is_fitted(sample):
