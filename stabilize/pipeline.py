@@ -242,10 +242,18 @@ def _rotations(
     shutter = None
     if job.log is not None:
         from stabilize.gyro.path import gyro_path  # gyro mode only
+        from stabilize.gyro.sync import MOTION_SCALE
 
         R, rolling, summary = gyro_path(
             settings, job.log, track, job.info.height, job.lens, job.stamps
         )
+        scale = summary["motion_scale"]
+        if not MOTION_SCALE[0] <= scale <= MOTION_SCALE[1]:
+            tell(
+                f"gyro: the video turns {scale:.2f} times as far as its gyro: a clip "
+                "stabilised in the camera (the output may shake more than the input), or "
+                "a focal length far off (--fov, --lens)"
+            )
     else:
         samples = track.samples
         agreeing = refined = None

@@ -25,7 +25,15 @@ from rotation import so3
 from stabilize.gyro import GyroLog, integrate_rotations
 from stabilize.gyro.axes import axes_code
 from stabilize.gyro.focal import focal_from_gyro
-from stabilize.gyro.sync import MIN_CORRELATION, IntervalRates, Sync, SyncOptions, visual_rates
+from stabilize.gyro.sync import (
+    MIN_CORRELATION,
+    MOTION_SCALE,
+    IntervalRates,
+    Sync,
+    SyncOptions,
+    motion_scale,
+    visual_rates,
+)
 from stabilize.motion.estimate import READOUT_BANDS
 from stabilize.motion.focal import estimate_motion
 from stabilize.motion.track import VisualTrack
@@ -35,13 +43,6 @@ from stabilize.video import VideoInfo
 from stabilize.warp.lens import Lens
 
 MAX_ERROR_SHARE = 1.0  # AAE over the mean rotation per frame: the estimate says nothing
-# The video's turn over the gyro's (Comparison.motion_scale) outside which the two do not
-# measure the same motion. A matched log reads about 1: karma 0.88 at the 69° default
-# (pitch and yaw scale with f_true/f, and its lens is wider), the rendered sample 1.00.
-# In-camera stabilisation turns the video far less than its gyro: max-heromode 0.17 (its
-# speeds still correlate at 0.90, so the correlation check passes it), hero7 0.02. A log
-# of degrees read as radians, or the other way, reads 57 times off.
-MOTION_SCALE = (0.5, 2.0)
 FOCAL_ROUNDS = 3  # re-estimations when fitting the focal length to the gyro
 FOCAL_CONVERGED = 0.005  # a relative change of the fitted focal length below which it stops
 
@@ -68,11 +69,9 @@ class Comparison:
         return np.degrees(np.abs(so3.log_so3(self.visual @ np.swapaxes(self.gyro, -1, -2)))).mean(0)
 
     def motion_scale(self) -> float:
-        """How far the video turns for each radian its gyro turns: the least-squares
-        scale of the visual rotation vectors on the gyro's, Σ v·g / Σ g·g (about 1 for
-        a matched log; see ``MOTION_SCALE``)."""
-        v, g = so3.log_so3(self.visual), so3.log_so3(self.gyro)
-        return float(np.sum(v * g) / max(np.sum(g * g), 1e-300))
+        """How far the video turns for each radian its gyro turns (about 1 for a
+        matched log: :func:`stabilize.gyro.sync.motion_scale`)."""
+        return motion_scale(self.visual, self.gyro)
 
     def warning(self) -> str | None:
         motion = np.degrees(so3.angle(self.gyro)).mean()

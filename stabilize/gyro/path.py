@@ -10,10 +10,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stabilize.gyro.load import readout_seconds
-from stabilize.gyro.log import GyroLog
+from stabilize.gyro.log import GyroError, GyroLog
 from stabilize.gyro.rolling_shutter import frame_rotations, row_turns
 from stabilize.gyro.source import gyro_rotations
-from stabilize.gyro.sync import SyncOptions
+from stabilize.gyro.sync import IMPOSSIBLE_SCALE, SyncOptions, motion_scale
 from stabilize.motion.track import VisualTrack
 from stabilize.settings import Settings
 from stabilize.warp.lens import Lens
@@ -43,6 +43,13 @@ def gyro_path(
     att, sync = gyro_rotations(log, track, options)
     clock = sync.clock(track.times)
     R = frame_rotations(att, clock, sync.offset, sync.readout)
+    scale = motion_scale(track.rotations, R)
+    if not IMPOSSIBLE_SCALE[0] < scale < IMPOSSIBLE_SCALE[1]:
+        raise GyroError(
+            f"{log.source}: the video turns {scale:.3g} times as far as this gyro says, "
+            "which no focal length explains: a log in another unit (degrees read as "
+            "radians?), or another clip's log"
+        )
     rolling = row_turns(att, clock, sync.offset, sync.readout, height) if sync.readout else None
     return (
         R,
@@ -52,6 +59,7 @@ def gyro_path(
             "offset_s": sync.offset,
             "R_cam_imu": sync.R_cam_imu.tolist(),
             "speed_correlation": sync.correlation,
+            "motion_scale": scale,  # the video's turn over the gyro's: about 1
             "rate_hz": log.rate_hz,
             "readout_ms": 1000.0 * sync.readout,
             "readout_estimated": sync.readout_estimated,

@@ -30,9 +30,30 @@ from stabilize.video.decode import frame_interval
 
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 MIN_CORRELATION = 0.6  # of angular speeds, below which a log does not match the video
+# The video's turn over the gyro's (motion_scale) outside which the two do not measure
+# the same motion. A matched log reads about 1: phone-cc9 1.01 at its calibrated f, the
+# rendered sample 1.00, karma 0.88 at the 69° default (pitch and yaw scale with f_true/f,
+# and its lens is wider). In-camera stabilisation turns the video far less than its gyro:
+# max-heromode 0.17, its speeds still correlating at 0.90; hero7 0.02. Outside the wider
+# bounds no focal length explains it: a log of degrees read as radians reads 1/57.
+MOTION_SCALE = (0.5, 2.0)
+IMPOSSIBLE_SCALE = (0.1, 10.0)
 MIN_COVERAGE = 0.8  # share of the frame pairs the log must cover (camera logs stop early)
 MAX_DRIFT = 2e-3  # clock-rate difference searched with fit_drift (crystals: ~1e-5..1e-4)
 MAX_READOUT_STDERR = 0.15  # of a frame interval: a less certain readout is not used
+
+
+def motion_scale(visual: NDArray, gyro: NDArray) -> float:
+    """How far the video turns for each radian its gyro turns: the least-squares scale
+    of the visual rotation vectors on the gyro's, Σ v·g / Σ g·g, over the frame pairs'
+    rotations (N, 3, 3) in camera axes.
+
+    >>> R = so3.exp_so3(np.array([[0.01, 0.0, 0.0], [0.0, -0.02, 0.005]]))
+    >>> round(motion_scale(so3.exp_so3(0.5 * so3.log_so3(R)), R), 6)
+    0.5
+    """
+    v, g = so3.log_so3(visual), so3.log_so3(gyro)
+    return float(np.sum(v * g) / max(np.sum(g * g), 1e-300))
 
 
 @dataclass(frozen=True)

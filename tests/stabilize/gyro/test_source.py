@@ -53,6 +53,7 @@ def test_stabilising_from_the_gyro(tmp_path):
     assert result.exit_code == 0, result.output
     summary = json.loads(result.output)
     assert abs(summary["gyro"]["offset_s"] - 0.35) < 1e-3
+    assert abs(summary["gyro"]["motion_scale"] - 1) < 0.05
     assert summary["frames"] == 90 and out.is_file()
 
 
@@ -99,6 +100,33 @@ def test_a_mismatched_gyro_is_refused(tmp_path):
     )
     assert result.exit_code != 0 and "does not match" in result.output
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("gain", "refused", "says"),
+    [
+        # degrees per second where the format says radians: no focal length explains it
+        (np.degrees(1.0), True, "another unit"),
+        # three times the turn the video shows: a clip stabilised in the camera, say
+        (3.0, False, "the video turns 0.34 times as far as its gyro"),
+    ],
+)
+def test_a_gyro_that_turns_far_more_than_the_video_is_said_or_refused(
+    tmp_path, gain, refused, says
+):
+    lines = (SAMPLE / "gyro.csv").read_text().splitlines()
+    scaled = tmp_path / "scaled.csv"
+    scaled.write_text(
+        "".join(
+            f"{gain * float(x)},{gain * float(y)},{gain * float(z)},{t}\n"
+            for x, y, z, t in (line.split(",") for line in lines)
+        )
+    )
+    out = tmp_path / "o.mp4"
+    args = ["run", str(SAMPLE / "clip.mp4"), str(out), "--gyro", str(scaled), "--fov", "70"]
+    result = CliRunner().invoke(app, [*args, "-q"])
+    assert (result.exit_code != 0) == refused and says in result.output
+    assert out.exists() != refused
 
 
 def test_rotations_gcsv_option(tmp_path):
