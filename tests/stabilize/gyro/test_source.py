@@ -13,6 +13,19 @@ from stabilize.gyro.sync import visual_rates
 from tests.stabilize.helpers import SAMPLE, held_upright
 
 
+def sample_log(path, gain: float = 1.0, shift_ns: int = 0):
+    """The sample's gyro log (x, y, z rad/s, t ns) written to ``path`` with its rates
+    times ``gain`` and its clock ``shift_ns`` later."""
+    rows = (line.split(",") for line in (SAMPLE / "gyro.csv").read_text().splitlines())
+    path.write_text(
+        "".join(
+            f"{gain * float(x)},{gain * float(y)},{gain * float(z)},{int(t) + shift_ns}\n"
+            for x, y, z, t in rows
+        )
+    )
+    return path
+
+
 def test_gcsv_export_round_trips_through_the_reader(tmp_path):
     times = np.arange(6) / 30.0
     R = so3.exp_so3(np.array([[0.01, -0.02, 0.005]] * 5))
@@ -67,14 +80,7 @@ def test_frame_times_on_the_gyro_clock_and_a_log_on_its_own(tmp_path):
     gyro = json.loads(result.stdout)["gyro"]
     assert abs(gyro["offset_s"]) < 2e-3 and not gyro["searched_whole_log"]
     # The same log on a boot clock 123456 s in: found by searching its whole span.
-    lines = (SAMPLE / "gyro.csv").read_text().splitlines()
-    shifted = tmp_path / "boot.csv"
-    shifted.write_text(
-        "".join(
-            f"{x},{y},{z},{int(t) + 123456 * 10**9}\n"
-            for x, y, z, t in (l.split(",") for l in lines)
-        )
-    )
+    shifted = sample_log(tmp_path / "boot.csv", shift_ns=123456 * 10**9)
     args = ["run", str(SAMPLE / "clip.mp4"), str(tmp_path / "boot.mp4"), "--gyro", str(shifted)]
     result = CliRunner().invoke(app, [*args, "--fov", "70", "-q", "--json"])
     assert result.exit_code == 0, result.output
@@ -114,14 +120,7 @@ def test_a_mismatched_gyro_is_refused(tmp_path):
 def test_a_gyro_that_turns_far_more_than_the_video_is_said_or_refused(
     tmp_path, gain, refused, says
 ):
-    lines = (SAMPLE / "gyro.csv").read_text().splitlines()
-    scaled = tmp_path / "scaled.csv"
-    scaled.write_text(
-        "".join(
-            f"{gain * float(x)},{gain * float(y)},{gain * float(z)},{t}\n"
-            for x, y, z, t in (line.split(",") for line in lines)
-        )
-    )
+    scaled = sample_log(tmp_path / "scaled.csv", gain=gain)
     out = tmp_path / "o.mp4"
     args = ["run", str(SAMPLE / "clip.mp4"), str(out), "--gyro", str(scaled), "--fov", "70"]
     result = CliRunner().invoke(app, [*args, "-q"])
