@@ -119,6 +119,7 @@ def stabilize_video(
         "size": list(job.info.shown_size[::-1]),  # as shown
         # counter-clockwise, degrees: the report's axes and pixels are the stored frames'
         "display_rotation": job.info.rotation,
+        "pixel_aspect": job.info.pixel_aspect,  # the input's; the output's pixels are square
         "field_order": job.info.field_order or None,  # the input's: tff, bff, progressive
         "deinterlaced": job.info.deinterlace,
         "focal_px": float(K[0, 0]),
@@ -167,7 +168,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
 
         stamps = sensor_frame_times(settings.gyro_timestamps, 0, len(times))
     mux = keep_streams(info, container_for(dst), info.video_delay)
-    notices = mux.notices + fields_notice(info)
+    notices = mux.notices + fields_notice(info) + pixels_notice(info)
     if not settings.size and frame_size(info, settings) != info.shown_size:
         (h, w), (sh, sw) = frame_size(info, settings), info.shown_size
         notices += (
@@ -187,6 +188,18 @@ def fields_notice(info: VideoInfo) -> tuple[str, ...]:
     if order:
         return (f"interlaced ({order}), left so (--deinterlace off): the warp blends its fields",)
     return ()
+
+
+def pixels_notice(info: VideoInfo) -> tuple[str, ...]:
+    """A notice where an anamorphic stream's pixels are not square: it is worked on, and
+    written, in square pixels at the size it is shown at."""
+    if info.coded is None:
+        return ()
+    h, w = info.shown_size
+    return (
+        f"anamorphic (pixels {info.pixel_aspect}): worked on and written in square pixels, "
+        f"{w}x{h}, as it is shown",
+    )
 
 
 def compiling_notice() -> tuple[str, ...]:

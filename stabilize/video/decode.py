@@ -40,7 +40,8 @@ def read_frames(
     options = {k.lstrip("-"): v for k, v in zip(args[::2], args[1::2], strict=True)}
     if not info.autorotate:
         options["noautorotate"] = None
-    shrink = size is not None and size != info.size
+    dh, dw = info.decoded_size
+    shrink = h <= dh and w <= dw and (h, w) != (dh, dw)
     if shrink:
         # Deblocking only smooths detail that the downscale averages away anyway; skipping
         # it makes the decode about 20% faster.
@@ -49,8 +50,9 @@ def read_frames(
     if info.deinterlace:  # before any scaling, which would blend the fields
         name, fields = deinterlace_filter(every_frame=not interlaced(info.field_order))
         stream = stream.filter(name, **fields)
-    if shrink:
-        stream = stream.filter("scale", w, h, flags="area")
+    if (h, w) != (dh, dw):  # to the working size, or an anamorphic stream widened
+        stream = stream.filter("scale", w, h, flags="area" if shrink else "bicubic")
+        stream = stream.filter("setsar", "1")
     process = (
         stream.output("pipe:", format="rawvideo", pix_fmt=pix_fmt, fps_mode="passthrough")
         .global_args("-hide_banner", "-loglevel", "error", "-nostdin")

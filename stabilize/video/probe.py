@@ -9,6 +9,7 @@ from __future__ import annotations
 import re
 import subprocess
 from dataclasses import dataclass, replace
+from fractions import Fraction
 from pathlib import Path
 
 from stabilize.video.binary import ffmpeg_exe
@@ -44,7 +45,9 @@ class VideoInfo:
     """What FFmpeg reports of a video: its first video stream, and every stream it has."""
 
     path: Path | str
-    width: int  # as decoded: as shown, after the display rotation (unless ``autorotate`` is off)
+    # as decoded: as shown, after the display rotation (unless ``autorotate`` is off), in
+    # square pixels (an anamorphic stream's frames are resampled to them: ``coded``)
+    width: int
     height: int
     fps: float
     duration: float | None
@@ -61,6 +64,11 @@ class VideoInfo:
     autorotate: bool = True  # whether FFmpeg turns the frames by the display rotation
     field_order: str = ""  # "progressive", "tff", "bff", or "" where FFmpeg names none
     deinterlace: bool = False  # whether frames are deinterlaced on decoding (bwdif)
+    # An anamorphic stream's sample aspect ratio (its pixels' width over their height, as
+    # "4:3"), and (H, W) of its frames as FFmpeg decodes them, before they are resampled
+    # to square pixels; None where the pixels are square
+    pixel_aspect: str = "1:1"
+    coded: tuple[int, int] | None = None
 
     @property
     def size(self) -> tuple[int, int]:
@@ -85,7 +93,13 @@ class VideoInfo:
         if not self.autorotate or self.rotation not in (90, 180, 270):
             return self
         h, w = self.size[::-1] if self.rotation != 180 else self.size
-        return replace(self, width=w, height=h, autorotate=False)
+        coded = self.coded and (self.coded[::-1] if self.rotation != 180 else self.coded)
+        return replace(self, width=w, height=h, autorotate=False, coded=coded)
+
+    @property
+    def decoded_size(self) -> tuple[int, int]:
+        """(H, W) of the frames as FFmpeg decodes them, before any resampling."""
+        return self.coded or self.size
 
     @property
     def video_delay(self) -> float:
@@ -123,6 +137,7 @@ _START = re.compile(r"Duration: [^\n]*?start: (-?\d+(?:\.\d+)?)")
 _STREAM = re.compile(
     r"Stream #0:(\d+)(?:\[\w+\])?(?:\((\w+)\))?: (Video|Audio|Subtitle|Data|Attachment): (\w+)"
 )
+_SAR = re.compile(r"\[SAR (\d+):(\d+) DAR")
 _ROTATION = re.compile(r"rotation of (-?\d+(?:\.\d+)?) degrees|rotate\s*:\s*(-?\d+)")
 
 
@@ -194,8 +209,16 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     )
     rot = _ROTATION.search(text)
     rotation = int(round(float(rot.group(1) or rot.group(2)))) % 360 if rot else 0
+    sar = _SAR.search(stream_line)
+    aspect = Fraction(int(sar.group(1)), int(sar.group(2))) if sar and int(sar.group(2)) else 1
+    aspect = aspect or Fraction(1)  # 0:1, "unknown": square
+    coded = None
+    if aspect != 1:  # widened to square pixels, to the even size nearest its display
+        coded = (h, w)
+        w = 2 * round(w * aspect / 2)
     if rotation in (90, 270):
         w, h = h, w
+        coded = coded and coded[::-1]
     streams = tuple(_stream(m, text) for m in _STREAM.finditer(text))
     has_audio = any(s.kind == "audio" for s in streams)
     start = _START.search(text)
@@ -217,4 +240,6 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
         colour_of(pix_fmt, video.group(3) or ""),
         field_order=(order := _field_order(path, input_args, video.group(3) or "")),
         deinterlace=interlaced(order),
+        pixel_aspect=f"{aspect.numerator}:{aspect.denominator}",
+        coded=coded,
     )

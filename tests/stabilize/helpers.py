@@ -41,6 +41,15 @@ def woven(clip: Path, folder: Path) -> Path:
     return out
 
 
+def squeezed(folder: Path) -> Path:
+    """The 640×360 sample stored 480×360 with 4:3 pixels (as HDV stores 1920×1080 in
+    1440×1080): shown the same."""
+    out = folder / "squeezed.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(SAMPLE / "clip.mp4"), "-vf"]
+    subprocess.run([*cmd, "scale=480:360,setsar=4/3", "-crf", "12", str(out)], check=True)
+    return out
+
+
 def combing(frame: NDArray) -> float:
     """How combed a frame's grey levels are: the mean of |row − the mean of its two
     neighbours| over that of |row above − row below|. Where the fields of a moving scene

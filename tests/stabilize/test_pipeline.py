@@ -15,7 +15,7 @@ from stabilize.motion.focal import initial_focal
 from stabilize.synth import SynthOptions, trajectory
 from stabilize.video import ffmpeg_exe, frame_times, probe, read_frames
 from tests.stabilize.conftest import render
-from tests.stabilize.helpers import combing, held_upright, woven
+from tests.stabilize.helpers import combing, held_upright, squeezed, woven
 
 
 @pytest.fixture(scope="module")
@@ -212,3 +212,14 @@ def test_an_interlaced_clip_comes_out_progressive_every_frame_kept(tmp_path):
     # warped woven (--deinterlace off), the fields blend into combs: 0.72, against 0.29
     # deinterlaced first and 0.50 for the 50 fps scene's own frames
     assert np.median([combing(f) for f in read_frames(out)]) < 0.45
+
+
+def test_an_anamorphic_clip_comes_out_in_square_pixels_as_shown(tmp_path):
+    clip = squeezed(tmp_path)  # 480×360 stored, 4:3 pixels: shown 640×360
+    out = tmp_path / "steady.mp4"
+    summary, _ = stabilize_video(clip, out, Settings(fov=70.0))
+    shown = probe(out)
+    assert shown.size == (360, 640) and shown.pixel_aspect == "1:1"
+    assert summary["pixel_aspect"] == "4:3" and summary["size"] == [640, 360]
+    assert any("anamorphic" in n for n in summary["notices"])
+    np.testing.assert_allclose(frame_times(out), frame_times(clip), atol=1e-3)
