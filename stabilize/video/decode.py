@@ -79,6 +79,16 @@ def read_frames(
 
 
 NOPTS = -(2**63)  # FFmpeg's AV_NOPTS_VALUE: a packet that carries no timestamp
+DISCARD = 0x4  # FFmpeg's AV_PKT_FLAG_DISCARD: a packet decoded but never shown
+
+
+def _discarded(row: list[str]) -> bool:
+    """Whether a framecrc row's packet is decoded only to decode the next ones, and never
+    shown: the frames an MP4's edit list cuts off its start (a clip trimmed without
+    re-encoding, ``ffmpeg -ss T -c copy`` or a phone's own trim, keeps the packets from
+    the keyframe before the cut). Its flags are the row's ``F=0x..`` field."""
+    flags = next((f.strip()[2:] for f in row[6:] if f.strip().startswith("F=")), "0")
+    return bool(int(flags, 16) & DISCARD)
 
 
 def frame_times(path: str | Path, input_args: tuple = ()) -> np.ndarray:
@@ -115,7 +125,8 @@ def _framecrc_times(path: str | Path, input_args: tuple, *, decode: bool) -> np.
     if result.returncode != 0 or tb is None:
         raise VideoError(f"{path}: cannot read frame timestamps")
     scale = int(tb.group(1)) / int(tb.group(2))
-    pts = [int(line.split(",")[2]) for line in result.stdout.splitlines() if line.startswith("0,")]
+    rows = [line.split(",") for line in result.stdout.splitlines() if line.startswith("0,")]
+    pts = [int(row[2]) for row in rows if not _discarded(row)]
     if not pts:
         raise VideoError(f"{path}: no video frames")
     if NOPTS in pts or len(set(pts)) < len(pts):

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from stabilize import Settings, stabilize_video
-from stabilize.video import ffmpeg_exe, frame_times, probe
+from stabilize.video import ffmpeg_exe, frame_times, probe, read_frames
 from stabilize.video.retime import is_variable_rate
 
 
@@ -67,3 +67,20 @@ def test_audio_stays_in_sync_within_a_millisecond(late_video, tmp_path, suffix):
     out = tmp_path / f"out{suffix}"
     stabilize_video(source, out, Settings(fov=70.0))
     assert av_offset(out) == pytest.approx(before, abs=1e-3)
+
+
+def test_a_clip_trimmed_without_re_encoding_keeps_the_frames_it_shows(shaky, tmp_path):
+    # `-ss` before `-c copy` keeps the packets from the keyframe before the cut, and an
+    # edit list that discards them: they decode, but no player shows them
+    trimmed = tmp_path / "trimmed.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-ss", "0.5", "-i", str(shaky), "-c", "copy"]
+    subprocess.run([*cmd, str(trimmed)], check=True)
+    shown = sum(1 for _ in read_frames(trimmed))
+    times = frame_times(trimmed)
+    assert shown == len(times) == 45 and times[0] == 0
+    np.testing.assert_allclose(np.diff(times), 1 / 30, atol=1e-6)
+    out = tmp_path / "out.mp4"
+    summary, _ = stabilize_video(trimmed, out, Settings(fov=70.0))
+    assert summary["frames"] == 45 and probe(out).has_audio
+    np.testing.assert_allclose(frame_times(out), times, atol=1e-3)
+    assert av_offset(out) == pytest.approx(av_offset(trimmed), abs=1e-3)
