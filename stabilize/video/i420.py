@@ -11,6 +11,8 @@ This module knows the layout only; warping the planes is :mod:`stabilize.warp.pl
 
 from __future__ import annotations
 
+import re
+
 import cv2
 import numpy as np
 from numpy.typing import NDArray
@@ -26,8 +28,15 @@ def black(frame: NDArray, full_range: bool = False) -> tuple[int, int, int]:
 
 
 def pipe_format(source_pix_fmt: str) -> str:
-    """The I420 pipe format that keeps a source's depth: 10 bits stay 10 bits."""
-    return "yuv420p10le" if "10" in source_pix_fmt else "yuv420p"
+    """The I420 pipe format that keeps a source's depth, as far as 4:2:0 video holds it:
+    a source of 10 bits or more (``yuv420p10le``, ``p010le``, a camera's or a grade's
+    ``yuv422p12le``, ``rgb48le``) travels at 10 bits, any other at 8.
+
+    >>> [pipe_format(f) for f in ("yuv420p", "yuvj420p", "p010le", "yuv422p12le", "rgb48le")]
+    ['yuv420p', 'yuv420p', 'yuv420p10le', 'yuv420p10le', 'yuv420p10le']
+    """
+    depth = re.search(r"(\d+)(?:le|be)$", source_pix_fmt)
+    return "yuv420p10le" if depth and int(depth.group(1)) >= 10 else "yuv420p"
 
 
 def pipe_layout(pix_fmt: str, size: tuple[int, int]) -> tuple[tuple[int, ...], type]:

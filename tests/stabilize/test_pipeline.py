@@ -169,10 +169,18 @@ def test_a_turned_clip_is_stabilised_as_its_sensor_stored_it(shaky, tmp_path, ro
         assert np.abs(shown.astype(int) - expected).mean() < 4  # the encoders' own loss
 
 
-def test_a_10_bit_source_stays_10_bit(shaky, tmp_path):
-    ten = tmp_path / "ten.mp4"
-    encode = ["-c:v", "libx264", "-pix_fmt", "yuv420p10le", "-c:a", "copy"]
-    subprocess.run([ffmpeg_exe(), "-v", "error", "-i", str(shaky), *encode, str(ten)], check=True)
+@pytest.mark.parametrize(
+    ("name", "encode"),
+    [
+        ("ten.mp4", ["-c:v", "libx264", "-pix_fmt", "yuv420p10le"]),
+        # a camera's or a grade's 4:2:2 at 12 bits: 4:2:0 video keeps 10 of them
+        ("twelve.mkv", ["-c:v", "ffv1", "-pix_fmt", "yuv422p12le"]),
+    ],
+)
+def test_a_deep_source_stays_10_bit(shaky, tmp_path, name, encode):
+    ten = tmp_path / name
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), *encode, "-c:a", "copy"]
+    subprocess.run([*cmd, str(ten)], check=True)
     out = tmp_path / "out.mp4"
     summary, _ = stabilize_video(ten, out, Settings(fov=70.0))
     assert probe(out).pix_fmt.startswith("yuv420p10") and summary["frames"] == 60
