@@ -37,6 +37,12 @@ def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0
             continue
         codec, flag = _codec(stream, container)
         where = _name(container)
+        if stream.kind == "video":  # a second camera's, a proxy's, a cover picture
+            notices.append(
+                f"left out video #{stream.index} ({stream.codec}): only the first video "
+                "stream is stabilised"
+            )
+            continue
         if codec is None:
             what = stream.codec if stream.codec != "none" else stream.tag  # e.g. GoPro's fdsc
             notices.append(

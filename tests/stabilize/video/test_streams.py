@@ -125,6 +125,14 @@ def test_avi_cannot_hold_subtitles_and_says_so(rich):
     assert sum("left out subtitle" in n for n in mux.notices) == 2
 
 
+def test_a_second_video_stream_is_left_out_and_said_so(shaky, tmp_path):
+    two = tmp_path / "two.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-map", "0:v", "-map", "0:v"]
+    subprocess.run([*cmd, "-map", "0:a", "-c", "copy", str(two)], check=True)
+    mux = keep_streams(probe(two), container_for("out.mp4"))
+    assert mux.notices == ("left out video #1 (h264): only the first video stream is stabilised",)
+
+
 def test_hevc_in_mp4_is_tagged_hvc1(tmp_path):
     out = tmp_path / "h.mp4"
     encoding = Encoding(codec="libx265", preset="ultrafast")
