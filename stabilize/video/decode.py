@@ -41,16 +41,18 @@ def read_frames(
     if not info.autorotate:
         options["noautorotate"] = None
     dh, dw = info.decoded_size
-    shrink = h <= dh and w <= dw and (h, w) != (dh, dw)
-    if shrink:
-        # Deblocking only smooths detail that the downscale averages away anyway; skipping
-        # it makes the decode about 20% faster.
+    resample = (h, w) != (dh, dw)  # to the working size, or an anamorphic stream's pixels
+    shrink = resample and h <= dh and w <= dw
+    if shrink and size is not None:
+        # Deblocking only smooths detail that the downscale to a working size averages
+        # away anyway; skipping it makes the decode about 20% faster. (Not where only an
+        # anamorphic stream's pixels are narrowed, DV's 720 to 640: that is the output.)
         options["skip_loop_filter"] = "all"
     stream = ffmpeg.input(str(path), **options)
     if info.deinterlace:  # before any scaling, which would blend the fields
         name, fields = deinterlace_filter(every_frame=not interlaced(info.field_order))
         stream = stream.filter(name, **fields)
-    if (h, w) != (dh, dw):  # to the working size, or an anamorphic stream widened
+    if resample:
         stream = stream.filter("scale", w, h, flags="area" if shrink else "bicubic")
         stream = stream.filter("setsar", "1")
     process = (
