@@ -169,6 +169,12 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
         stamps = sensor_frame_times(settings.gyro_timestamps, 0, len(times))
     mux = keep_streams(info, container_for(dst), info.video_delay)
     notices = mux.notices + fields_notice(info) + pixels_notice(info)
+    codec = settings.encoding.codec_for(container_for(dst))
+    if info.colour.hdr10_lost(codec):
+        notices += (
+            f"HDR10's mastering display and light levels left out: {codec} does not write "
+            "them (libx264 and libx265 do)",
+        )
     if not settings.size and frame_size(info, settings) != info.shown_size:
         (h, w), (sh, sw) = frame_size(info, settings), info.shown_size
         notices += (

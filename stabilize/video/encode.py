@@ -117,7 +117,9 @@ class FrameWriter:
         for extra in mux.inputs:
             cmd += list(extra)
         cmd += ["-map", "0:v", *mux.args, *_delayed(mux.video_delay)]
-        cmd += [*output_args(path, encoding, container), *colour.ffmpeg_args(), str(path)]
+        codec = encoding.codec_for(container or container_for(path))
+        cmd += [*output_args(path, encoding, container), *colour.ffmpeg_args()]
+        cmd += [*colour.hdr10_args(codec), str(path)]
         self._process = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
         widen_pipe(self._process.stdin)
 

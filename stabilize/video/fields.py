@@ -14,10 +14,6 @@ for each frame: every frame and its time stay as they were, and the output is pr
 from __future__ import annotations
 
 import re
-import subprocess
-from pathlib import Path
-
-from stabilize.video.binary import ffmpeg_exe
 
 # What ``ffmpeg -i`` prints, in the parentheses after the pixel format, for each field
 # order (libavcodec's av_field_order names), and ours: tff and bff are top and bottom
@@ -51,15 +47,15 @@ def field_order(details: str) -> str:
 _FRAME_ORDER = {"P": "progressive", "T": "tff", "B": "bff"}
 
 
-def first_frame_field_order(path: str | Path, input_args: tuple = ()) -> str:
-    """The field order the decoder flags the first video frame with (FFmpeg's
-    ``showinfo``): for a stream whose header names none. A DV camcorder's stream, in
-    AVI, is one: its frames are flagged interlaced, its stream is not. Decodes one
-    frame (about 30–50 ms here); ``""`` where none decodes."""
-    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i", str(path)]
-    cmd += ["-map", "0:v:0", "-vf", "showinfo", "-frames:v", "1", "-f", "null", "-"]
-    result = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
-    flag = re.search(r"Parsed_showinfo.*? i:([PTB]) ", result.stderr)
+def frame_field_order(report: str) -> str:
+    """The field order a decoded frame is flagged with, from its ``showinfo`` report
+    (:func:`stabilize.video.first_frame.first_frame_report`): a DV camcorder's stream in
+    AVI flags its frames interlaced, and its header says nothing. ``""`` where none.
+
+    >>> frame_field_order("[Parsed_showinfo_0 @ 0x1] n:   0 pts: 0 fmt:yuv420p i:T iskey:1")
+    'tff'
+    """
+    flag = re.search(r" i:([PTB]) ", report)
     return _FRAME_ORDER[flag.group(1)] if flag else ""
 
 

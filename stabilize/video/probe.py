@@ -13,13 +13,10 @@ from fractions import Fraction
 from pathlib import Path
 
 from stabilize.video.binary import ffmpeg_exe
-from stabilize.video.colour import UNKNOWN, Colour, colour_of
-from stabilize.video.fields import (
-    DEINTERLACE_MODES,
-    field_order,
-    first_frame_field_order,
-    interlaced,
-)
+from stabilize.video.colour import UNKNOWN, Colour, colour_of, with_hdr10
+from stabilize.video.fields import DEINTERLACE_MODES, field_order, frame_field_order, interlaced
+from stabilize.video.first_frame import first_frame_report
+from stabilize.video.i420 import pipe_format
 
 
 class VideoError(ValueError):
@@ -161,10 +158,17 @@ def _stream(match: re.Match, text: str) -> Stream:
     )
 
 
-def _field_order(path: Path, input_args: tuple, details: str) -> str:
-    """The stream's field order as its header names it, else as its first frame is
-    flagged (:mod:`stabilize.video.fields`)."""
-    return field_order(details) or first_frame_field_order(path, input_args)
+def _from_frames(path: Path, input_args: tuple, pix_fmt: str, details: str) -> tuple[str, Colour]:
+    """The field order and the colour description, from the stream's header, and from
+    its first decoded frame where the header leaves them open: the field order where it
+    names none (:mod:`stabilize.video.fields`), the HDR10 metadata of a stream of 10
+    bits or more (:mod:`stabilize.video.colour`)."""
+    order, colour = field_order(details), colour_of(pix_fmt, details)
+    deep = pipe_format(pix_fmt) != "yuv420p"
+    if order and not deep:
+        return order, colour
+    report = first_frame_report(path, input_args)
+    return order or frame_field_order(report), with_hdr10(colour, report)
 
 
 def sequence_args(path: str | Path, start_number: int | None, fps: float | None) -> tuple:
@@ -219,6 +223,7 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     if rotation in (90, 270):
         w, h = h, w
         coded = coded and coded[::-1]
+    order, colour = _from_frames(path, input_args, pix_fmt, video.group(3) or "")
     streams = tuple(_stream(m, text) for m in _STREAM.finditer(text))
     has_audio = any(s.kind == "audio" for s in streams)
     start = _START.search(text)
@@ -237,8 +242,8 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
         float(start.group(1)) if start else 0.0,
         len(re.findall(r"^\s+Chapter #", text, re.M)),
         text[: text.find("Stream #")],
-        colour_of(pix_fmt, video.group(3) or ""),
-        field_order=(order := _field_order(path, input_args, video.group(3) or "")),
+        colour,
+        field_order=order,
         deinterlace=interlaced(order),
         pixel_aspect=f"{aspect.numerator}:{aspect.denominator}",
         coded=coded,

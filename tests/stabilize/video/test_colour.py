@@ -11,7 +11,7 @@ import pytest
 from numpy.typing import NDArray
 
 from stabilize import Settings, stabilize_video
-from stabilize.video import ffmpeg_exe, probe, read_frames
+from stabilize.video import Encoding, ffmpeg_exe, probe, read_frames
 from stabilize.video.colour import Colour, colour_of
 from stabilize.video.i420 import black
 
@@ -93,3 +93,35 @@ def test_a_source_that_says_nothing_gets_the_encoders_defaults(shaky, tmp_path):
     out = tmp_path / "out.mp4"
     stabilize_video(shaky, out, Settings())
     assert probe(out).colour.range in (None, "tv")
+
+
+MASTERING = "G(13250,34500)B(7500,3000)R(34000,16000)WP(15635,16450)L(10000000,50)"
+
+
+@pytest.fixture(scope="module")
+def hdr10(shaky, tmp_path_factory) -> Path:
+    """The shaky clip as HDR10 HEVC: PQ, BT.2020, with its mastering display (P3 on a
+    1000 cd/m² monitor) and light levels in its frames' SEI, as a phone writes it."""
+    out = tmp_path_factory.mktemp("hdr10") / "hdr10.mp4"
+    x265 = f"hdr10=1:master-display={MASTERING}:max-cll=1000,400:log-level=error"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-c:v", "libx265"]
+    cmd += ["-preset", "ultrafast", "-pix_fmt", "yuv420p10le", "-x265-params", x265]
+    subprocess.run([*cmd, "-c:a", "copy", str(out)], check=True)
+    return out
+
+
+@pytest.mark.parametrize("codec", ["libx264", "libx265"])
+def test_hdr10_metadata_is_read_and_written_again(hdr10, tmp_path, codec):
+    source = probe(hdr10).colour
+    assert source.mastering == MASTERING and source.light == "1000,400"
+    out = tmp_path / "out.mkv"
+    settings = Settings(fov=70.0, encoding=Encoding(codec=codec, preset="ultrafast"))
+    summary, _ = stabilize_video(hdr10, out, settings)
+    written = probe(out).colour
+    assert (written.mastering, written.light) == (MASTERING, "1000,400")
+    assert not any("HDR10" in n for n in summary["notices"])
+
+
+def test_hdr10_metadata_an_encoder_cannot_write_is_said_lost(hdr10, tmp_path):
+    summary, _ = stabilize_video(hdr10, tmp_path / "out.webm", Settings(fov=70.0))
+    assert any("HDR10's mastering display" in n for n in summary["notices"])
