@@ -44,6 +44,7 @@ from stabilize.path.zoom import CROP_MODES
 from stabilize.progress import ProgressFactory, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoInfo, atomic_output, frame_interval, frame_times, probe
+from stabilize.video.bars import detect_bars
 from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Mux
 from stabilize.video.fields import DEINTERLACE_MODES
@@ -116,10 +117,11 @@ def stabilize_video(
         "input": str(src),
         "output": str(dst),
         "frames": frames,
-        "size": list(job.info.shown_size[::-1]),  # as shown
+        "size": list(job.info.shown_framed_size[::-1]),  # as shown, its bars included
         # counter-clockwise, degrees: the report's axes and pixels are the stored frames'
         "display_rotation": job.info.rotation,
         "pixel_aspect": job.info.pixel_aspect,  # the input's; the output's pixels are square
+        "bars": None if job.info.bars is None else list(job.info.bars),  # top, bottom, left, right
         "field_order": job.info.field_order or None,  # the input's: tff, bff, progressive
         "deinterlaced": job.info.deinterlace,
         "focal_px": float(K[0, 0]),
@@ -156,8 +158,11 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
         from stabilize.gyro.load import load_gyro
 
         log = load_gyro(settings)
-    # the sensor's rows, whichever way the camera was held; its fields woven into frames
+    # the sensor's rows, whichever way the camera was held; its fields woven into frames;
+    # the picture inside black bars baked into the frame
     info = probe(src).stored().deinterlaced(settings.deinterlace)
+    if settings.bars == "auto" and not settings.lens:  # a lens's frame is the sensor's
+        info = info.within_bars(detect_bars(info))
     check_writable(dst)
     check_encoder(dst, settings.encoding, encoded_size(info, settings))
     lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
@@ -168,15 +173,15 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
 
         stamps = sensor_frame_times(settings.gyro_timestamps, 0, len(times))
     mux = keep_streams(info, container_for(dst), info.video_delay)
-    notices = mux.notices + fields_notice(info) + pixels_notice(info)
+    notices = mux.notices + fields_notice(info) + pixels_notice(info) + bars_notice(info)
     codec = settings.encoding.codec_for(container_for(dst))
     if info.colour.hdr10_lost(codec):
         notices += (
             f"HDR10's mastering display and light levels left out: {codec} does not write "
             "them (libx264 and libx265 do)",
         )
-    if not settings.size and frame_size(info, settings) != info.shown_size:
-        (h, w), (sh, sw) = frame_size(info, settings), info.shown_size
+    if not settings.size and frame_size(info, settings) != info.shown_framed_size:
+        (h, w), (sh, sw) = frame_size(info, settings), info.shown_framed_size
         notices += (
             f"{sw}x{sh} has an odd side: the output is {w}x{h}, the last row or column "
             "cropped (4:2:0 video needs even sides)",
@@ -201,10 +206,27 @@ def pixels_notice(info: VideoInfo) -> tuple[str, ...]:
     written, in square pixels at the size it is shown at."""
     if info.coded is None:
         return ()
-    h, w = info.shown_size
+    h, w = info.shown_framed_size
     return (
         f"anamorphic (pixels {info.pixel_aspect}): worked on and written in square pixels, "
         f"{w}x{h}, as it is shown",
+    )
+
+
+def bars_notice(info: VideoInfo) -> tuple[str, ...]:
+    """A notice where black bars frame the picture: it is stabilised inside them, and
+    they stay still."""
+    if info.bars is None:
+        return ()
+    top, bottom, left, right = info.bars
+    where = [
+        f"{a} and {b} px {side}"
+        for a, b, side in ((top, bottom, "above and below"), (left, right, "left and right"))
+        if a or b
+    ]
+    return (
+        f"black bars ({'; '.join(where)}): the picture inside them is stabilised, and "
+        "they are kept still around it (--bars off: stabilised with it)",
     )
 
 
@@ -342,6 +364,7 @@ def check_settings(settings: Settings) -> None:
             settings.deinterlace in DEINTERLACE_MODES,
             f"--deinterlace must be one of {', '.join(DEINTERLACE_MODES)}",
         ),
+        (settings.bars in ("auto", "off"), "--bars must be auto or off"),
         (
             settings.fov in (None, "auto")
             or (isinstance(settings.fov, int | float) and 0 < settings.fov < 180),

@@ -74,6 +74,9 @@ class Settings:
     # interlaced input (stabilize.video.fields): 'auto' deinterlaces a stream flagged
     # interlaced, 'on' every stream (one flagged progressive but combed), 'off' none
     deinterlace: str = "auto"
+    # black bars baked into the frame (stabilize.video.bars): 'auto' stabilises the
+    # picture inside them and keeps them still, 'off' warps them with it
+    bars: str = "auto"
     encoding: Encoding = field(default_factory=Encoding)
 
     def focal_px(self, size: tuple[int, int]) -> float:

@@ -102,6 +102,13 @@ DeinterlaceOption = Annotated[
         "interlaced, on every stream (one flagged progressive but combed), off none."
     ),
 ]
+BarsOption = Annotated[
+    Literal["auto", "off"],
+    typer.Option(
+        help="Black bars baked into the frame (letterbox, pillarbox): auto stabilises the "
+        "picture inside them and keeps them still; off warps them with it."
+    ),
+]
 PreviewOption = Annotated[
     Literal["none", "side-by-side"],
     typer.Option(help="side-by-side: the original and the stabilised clip next to each other."),
@@ -205,6 +212,7 @@ def job_settings(params: Mapping[str, Any]) -> Settings:
         preview=preview == "side-by-side",
         size=output_size(params["size"]),
         deinterlace=params.get("deinterlace", DEFAULTS.deinterlace),
+        bars=params.get("bars", DEFAULTS.bars),
         encoding=Encoding(codec=params["codec"], crf=params["crf"], preset=params["preset"]),
         gyro=str(gyro) if gyro and gyro != "auto" else None,
         gyro_lpf=params["gyro_lpf"],

@@ -12,6 +12,7 @@ from stabilize.cli.options import (
     ENCODING,
     GYRO_SEARCH,
     NO_PREVIEW,
+    BarsOption,
     CodecOption,
     CrfOption,
     CropOption,
@@ -85,6 +86,7 @@ def run(
     preview: PreviewOption = NO_PREVIEW,
     size: SizeOption = None,
     deinterlace: DeinterlaceOption = DEFAULTS.deinterlace,
+    bars: BarsOption = DEFAULTS.bars,
     gyro: Path | None = typer.Option(
         None, help="Stabilise from this gyro log (synchronised to the video) instead."
     ),

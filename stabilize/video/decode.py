@@ -52,7 +52,15 @@ def read_frames(
     if info.deinterlace:  # before any scaling, which would blend the fields
         name, fields = deinterlace_filter(every_frame=not interlaced(info.field_order))
         stream = stream.filter(name, **fields)
-    if resample:
+    if info.bars:  # the picture inside them, in square pixels, then at ``size``
+        fh, fw = info.framed_size
+        if (fh, fw) != (dh, dw):
+            stream = stream.filter("scale", fw, fh, flags="bicubic").filter("setsar", "1")
+        top, _, left, _ = info.bars
+        stream = stream.filter("crop", info.width, info.height, left, top)
+        if (h, w) != info.size:
+            stream = stream.filter("scale", w, h, flags="area" if shrink else "bicubic")
+    elif resample:
         stream = stream.filter("scale", w, h, flags="area" if shrink else "bicubic")
         stream = stream.filter("setsar", "1")
     process = (

@@ -66,6 +66,11 @@ class VideoInfo:
     # to square pixels; None where the pixels are square
     pixel_aspect: str = "1:1"
     coded: tuple[int, int] | None = None
+    # Black bars baked into the frame (:mod:`stabilize.video.bars`): (top, bottom, left,
+    # right) px, and the whole frame's (H, W); the frames are then the picture inside
+    # them (``size``), and the bars are put back around it on writing
+    bars: tuple[int, int, int, int] | None = None
+    framed: tuple[int, int] | None = None
 
     @property
     def size(self) -> tuple[int, int]:
@@ -96,7 +101,29 @@ class VideoInfo:
     @property
     def decoded_size(self) -> tuple[int, int]:
         """(H, W) of the frames as FFmpeg decodes them, before any resampling."""
-        return self.coded or self.size
+        return self.coded or self.framed_size
+
+    @property
+    def framed_size(self) -> tuple[int, int]:
+        """(H, W) of the whole frame, its bars included (``size`` without bars)."""
+        return self.framed or self.size
+
+    @property
+    def shown_framed_size(self) -> tuple[int, int]:
+        """(H, W) of the whole frame as a player shows it, its bars included."""
+        return self.framed_size[::-1] if self.turns % 2 else self.framed_size
+
+    def within_bars(self, bars: tuple[int, int, int, int] | None) -> VideoInfo:
+        """The video decoded as the picture inside ``bars`` (top, bottom, left, right:
+        px of its frames as decoded, even), which writing puts back around it. Last of
+        :meth:`stored` and :meth:`deinterlaced`: the bars are the decoded frames'."""
+        if not bars:
+            return self
+        top, bottom, left, right = bars
+        h, w = self.size
+        return replace(
+            self, width=w - left - right, height=h - top - bottom, bars=bars, framed=(h, w)
+        )
 
     @property
     def video_delay(self) -> float:

@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
 from stabilize.video import FrameWriter, VideoInfo, i420, read_frames
+from stabilize.video.bars import put_back
 from stabilize.video.containers import container_for
 from stabilize.video.encode import Mux
 from stabilize.video.retime import is_variable_rate, retime
@@ -63,12 +64,14 @@ def render(
     resize = resize_planes if planar else resize_image
 
     def shown(frame: NDArray) -> NDArray:
-        """A decoded or warped frame as it is written: turned to be shown, then at the
-        output's size."""
+        """A decoded or warped frame as it is written: framed by its black bars again,
+        turned to be shown, then at the output's size."""
+        if info.bars:
+            frame = put_back(frame, info.bars, planar, info.colour.full_range)
         frame = turn(frame, info.turns, planar)
         if settings.size:
             return resize(frame, (h, w))
-        if (h, w) != info.shown_size:  # odd sides: one row or column off the edge
+        if (h, w) != info.shown_framed_size:  # odd sides: one row or column off the edge
             return frame[:h, :w]
         return frame
 
@@ -104,10 +107,11 @@ def render(
 
 
 def frame_size(info: VideoInfo, settings: Settings) -> tuple[int, int]:
-    """(H, W) of each stabilised frame as shown: ``--size``, else the input's with odd
+    """(H, W) of each stabilised frame as shown: ``--size``, else the input's (its black
+    bars included: :mod:`stabilize.video.bars`) with odd
     sides rounded down (4:2:0 video needs even sides; the last row or column is cropped,
     the smallest loss, and at the frame's edge, which the zoom crops anyway)."""
-    h, w = settings.size or info.shown_size
+    h, w = settings.size or info.shown_framed_size
     return h - h % 2, w - w % 2
 
 

@@ -50,6 +50,15 @@ def squeezed(folder: Path) -> Path:
     return out
 
 
+def boxed(clip: Path, folder: Path, pad: str) -> Path:
+    """``clip`` framed by black bars baked into it, as FFmpeg's ``pad`` filter puts them
+    (``W:H:X:Y``): a letterbox or a pillarbox."""
+    out = folder / "boxed.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(clip), "-vf", f"pad={pad}:black"]
+    subprocess.run([*cmd, "-crf", "12", "-c:a", "copy", str(out)], check=True)
+    return out
+
+
 def combing(frame: NDArray) -> float:
     """How combed a frame's grey levels are: the mean of |row − the mean of its two
     neighbours| over that of |row above − row below|. Where the fields of a moving scene

@@ -15,7 +15,7 @@ from stabilize.motion.focal import initial_focal
 from stabilize.synth import SynthOptions, trajectory
 from stabilize.video import ffmpeg_exe, frame_times, probe, read_frames
 from tests.stabilize.conftest import render
-from tests.stabilize.helpers import combing, held_upright, squeezed, woven
+from tests.stabilize.helpers import boxed, combing, held_upright, squeezed, woven
 
 
 @pytest.fixture(scope="module")
@@ -231,3 +231,23 @@ def test_an_anamorphic_clip_comes_out_in_square_pixels_as_shown(tmp_path):
     assert summary["pixel_aspect"] == "4:3" and summary["size"] == [640, 360]
     assert any("anamorphic" in n for n in summary["notices"])
     np.testing.assert_allclose(frame_times(out), frame_times(clip), atol=1e-3)
+
+
+def _bar_edges(path: Path) -> np.ndarray:
+    """Each frame's first row from the top whose middle is not black."""
+    return np.array([np.argmax(f[:, 100:220].max(axis=(1, 2)) > 40) for f in read_frames(path)])
+
+
+def test_black_bars_stay_still_around_the_stabilised_picture(shaky, tmp_path):
+    clip = boxed(shaky, tmp_path, "320:240:0:30")  # a letterbox: 30 px above and below
+    out = tmp_path / "steady.mp4"
+    summary, _ = stabilize_video(clip, out, Settings(fov=70.0))
+    assert summary["bars"] == [30, 30, 0, 0] and summary["size"] == [320, 240]
+    assert any("black bars" in n for n in summary["notices"])
+    assert probe(out).size == (240, 320) and summary["frames"] == 60
+    np.testing.assert_allclose(frame_times(out), frame_times(clip), atol=1e-3)
+    np.testing.assert_array_equal(_bar_edges(out), 30)  # the picture starts at row 30
+    # the picture's own edge, warped with the bars, wanders with the shake
+    warped = tmp_path / "warped.mp4"
+    stabilize_video(clip, warped, Settings(fov=70.0, bars="off"))
+    assert np.ptp(_bar_edges(warped)) > 4

@@ -63,6 +63,7 @@ CASES = {
     "device": Case(("--device", "gpu"), 2),
     "preview": Case(("--preview", "stacked"), 2),
     "deinterlace": Case(("--deinterlace", "sideways"), 2),
+    "bars": Case(("--bars", "sometimes"), 2),
     "fov zero": Case(("--fov", "0"), 2),
     "fov 200": Case(("--fov", "200"), 2),
     "focal negative": Case(("--focal", "-5"), 2),

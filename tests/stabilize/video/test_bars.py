@@ -1,0 +1,52 @@
+"""Black bars baked into the frame: found, the picture inside them decoded alone, and
+the bars put back around it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from stabilize.video import i420, probe, read_frames
+from stabilize.video.bars import detect_bars, put_back
+from tests.stabilize.helpers import SAMPLE, boxed
+
+
+@pytest.mark.parametrize(
+    ("pad", "bars"),
+    [
+        ("640:480:0:60", (60, 60, 0, 0)),  # a letterbox: 16:9 shown in 4:3
+        # a pillarbox: 4:2:0 puts the picture at an even column, 106 (the right bar 108)
+        ("854:360:107:0", (0, 0, 106, 108)),
+    ],
+)
+def test_bars_are_found_and_the_picture_inside_them_decoded_alone(tmp_path, pad, bars):
+    clip = boxed(SAMPLE / "clip.mp4", tmp_path, pad)
+    info = probe(clip)
+    assert detect_bars(info) == bars
+    inside = info.within_bars(bars)
+    top, bottom, left, right = bars
+    assert inside.framed_size == info.size
+    assert inside.size == (info.height - top - bottom, info.width - left - right)
+    picture = np.stack(list(read_frames(clip, info=inside)))
+    whole = np.stack(list(read_frames(clip, info=info)))
+    h, w = inside.size
+    np.testing.assert_array_equal(picture, whole[:, top : top + h, left : left + w])
+
+
+def test_a_clip_without_bars_has_none():
+    assert detect_bars(probe(SAMPLE / "clip.mp4")) is None
+    info = probe(SAMPLE / "clip.mp4")
+    assert info.within_bars(None) is info
+
+
+@pytest.mark.parametrize("dtype", [np.uint8, np.uint16])
+def test_the_bars_are_put_back_in_the_ranges_black(dtype):
+    y = np.full((4, 6), 200, dtype)
+    u, v = np.full((2, 3), 100, dtype), np.full((2, 3), 90, dtype)
+    framed = put_back(i420.join(y, u, v), (2, 2, 4, 0), planar=True, full_range=True)
+    fy, fu, fv = i420.split(framed)
+    assert fy.shape == (8, 10) and fu.shape == fv.shape == (4, 5)
+    np.testing.assert_array_equal(fy[2:6, 4:], y)
+    np.testing.assert_array_equal(fu[1:3, 2:], u)
+    black = i420.black(framed, full_range=True)
+    assert fy[0, 0] == black[0] and fu[0, 0] == black[1] and fv[-1, 0] == black[2]
