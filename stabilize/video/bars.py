@@ -10,10 +10,10 @@ is 582 (true 573.85). So the picture inside the bars is worked on alone, and the
 are put back still around it (:meth:`stabilize.video.VideoInfo.within_bars`).
 
 They are found by FFmpeg's ``cropdetect`` over the whole clip: the rows and columns that
-stay black (at most 24 of 255) in every frame it reads: its keyframes (a few ms each), or
-where a clip has fewer than three, every third frame of its first 1.5 s. Only
-bars a letterbox or pillarbox makes are taken: each at least 2% of its side, the two of
-a pair within 1% of each other, the picture at least half of each side.
+stay black (within 8 of 255 of the range's black) in every frame it reads: its
+keyframes (a few ms each), or where a clip has fewer than three, every third frame of its
+first 1.5 s. Only bars a letterbox or pillarbox makes are taken: each at least 2% of its
+side, the two of a pair within 1% of each other, the picture at least half of each side.
 """
 
 from __future__ import annotations
@@ -29,7 +29,9 @@ from stabilize.video import i420
 from stabilize.video.binary import ffmpeg_exe
 from stabilize.video.probe import VideoInfo
 
-BLACK = 24 / 255  # cropdetect's limit: brighter than this is picture (its own default)
+# cropdetect's limit, of 255: brighter than the range's black (16 limited, 0 full) by
+# more than a compression's noise is picture (limited: 24, cropdetect's own default)
+ABOVE_BLACK = 8
 MIN_BAR = 0.02  # of its side: a thinner black edge is the picture's, or an encoder's
 PAIR = 0.01  # of its side: how far a letterbox's or pillarbox's two bars may differ
 MIN_PICTURE = 0.5  # of each side: less is not a picture in bars
@@ -46,7 +48,8 @@ def detect_bars(info: VideoInfo) -> tuple[int, int, int, int] | None:
     h, w = info.size
     options = [*info.input_args, *(() if info.autorotate else ("-noautorotate",))]
     chain = [f"scale={w}:{h},setsar=1"] if info.coded else []
-    chain.append(f"cropdetect=limit={BLACK:.4f}:reset=0:skip=0")
+    black = (0 if info.colour.full_range else 16) + ABOVE_BLACK
+    chain.append(f"cropdetect=limit={black / 255:.4f}:reset=0:skip=0")
     crops = _cropdetect(info.path, options, ["-skip_frame", "nokey"], chain)
     if len(crops) < SAMPLES:  # a clip encoded with few keyframes: its first seconds
         every_third = ["select='not(mod(n\\,3))'", *chain]
