@@ -3,10 +3,12 @@ the bars put back around it."""
 
 from __future__ import annotations
 
+import subprocess
+
 import numpy as np
 import pytest
 
-from stabilize.video import i420, probe, read_frames
+from stabilize.video import ffmpeg_exe, i420, probe, read_frames
 from stabilize.video.bars import detect_bars, put_back
 from tests.stabilize.helpers import SAMPLE, boxed
 
@@ -50,3 +52,26 @@ def test_the_bars_are_put_back_in_the_ranges_black(dtype):
     np.testing.assert_array_equal(fu[1:3, 2:], u)
     black = i420.black(framed, full_range=True)
     assert fy[0, 0] == black[0] and fu[0, 0] == black[1] and fv[-1, 0] == black[2]
+
+
+@pytest.mark.parametrize(
+    ("bands", "found"),
+    [
+        # full range: black is 0, as FFmpeg's pad puts it
+        ("format=yuvj420p,scale=640:280,pad=640:360:0:40:black", True),
+        # and a night's dark edges, at 20 of 255, are picture (cropdetect's own limit,
+        # 24, took them for bars)
+        (
+            "format=yuvj420p,drawbox=y=0:w=iw:h=40:color=0x050505:t=fill,"
+            "drawbox=y=ih-40:w=iw:h=40:color=0x050505:t=fill",
+            False,
+        ),
+    ],
+)
+def test_bars_of_a_full_range_picture_are_its_black_alone(tmp_path, bands, found):
+    clip = tmp_path / "dark.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(SAMPLE / "clip.mp4"), "-vf", bands]
+    subprocess.run([*cmd, "-pix_fmt", "yuvj420p", "-crf", "12", str(clip)], check=True)
+    info = probe(clip)
+    assert info.colour.full_range
+    assert detect_bars(info) == ((40, 40, 0, 0) if found else None)
