@@ -13,7 +13,8 @@ They are found by FFmpeg's ``cropdetect`` over the whole clip: the rows and colu
 stay black (within 8 of 255 of the range's black) in every frame it reads: its
 keyframes (a few ms each), or where a clip has fewer than three, every third frame of its
 first 1.5 s. Only bars a letterbox or pillarbox makes are taken: each at least 2% of its
-side, the two of a pair within 1% of each other, the picture at least half of each side.
+side, the two of a pair within 1% of each other, the picture at least a quarter of each
+side (a 9:16 picture pillarboxed into a 16:9 frame spans 0.32 of its width).
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ from stabilize.video.probe import VideoInfo
 ABOVE_BLACK = 8
 MIN_BAR = 0.02  # of its side: a thinner black edge is the picture's, or an encoder's
 PAIR = 0.01  # of its side: how far a letterbox's or pillarbox's two bars may differ
-MIN_PICTURE = 0.5  # of each side: less is not a picture in bars
+MIN_PICTURE = 0.25  # of each side: a 9:16 picture in a 16:9 frame spans 0.32 of it
 SAMPLES = 3  # frames read at the least
 
 # the extents of what is not black, over every frame read so far (reset=0)

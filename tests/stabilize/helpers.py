@@ -50,11 +50,13 @@ def squeezed(folder: Path) -> Path:
     return out
 
 
-def boxed(clip: Path, folder: Path, pad: str) -> Path:
-    """``clip`` framed by black bars baked into it, as FFmpeg's ``pad`` filter puts them
-    (``W:H:X:Y``): a letterbox or a pillarbox."""
+def boxed(clip: Path, folder: Path, pad: str, before: str = "") -> Path:
+    """``clip`` (through the FFmpeg filter ``before``, if any) framed by black bars baked
+    into it, as FFmpeg's ``pad`` filter puts them (``W:H:X:Y``): a letterbox or a
+    pillarbox."""
     out = folder / "boxed.mp4"
-    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(clip), "-vf", f"pad={pad}:black"]
+    chain = ",".join(f for f in (before, f"pad={pad}:black") if f)
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(clip), "-vf", chain]
     subprocess.run([*cmd, "-crf", "12", "-c:a", "copy", str(out)], check=True)
     return out
 

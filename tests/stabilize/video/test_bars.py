@@ -19,10 +19,13 @@ from tests.stabilize.helpers import SAMPLE, boxed
         ("640:480:0:60", (60, 60, 0, 0)),  # a letterbox: 16:9 shown in 4:3
         # a pillarbox: 4:2:0 puts the picture at an even column, 106 (the right bar 108)
         ("854:360:107:0", (0, 0, 106, 108)),
+        # a clip shot upright, shown in a wide frame: the picture a third of its width
+        ("640:360:219:0", (0, 0, 218, 220)),
     ],
 )
 def test_bars_are_found_and_the_picture_inside_them_decoded_alone(tmp_path, pad, bars):
-    clip = boxed(SAMPLE / "clip.mp4", tmp_path, pad)
+    upright = pad.startswith("640:360")  # the sample's middle 202×360 first
+    clip = boxed(SAMPLE / "clip.mp4", tmp_path, pad, "crop=202:360" if upright else "")
     info = probe(clip)
     assert detect_bars(info) == bars
     inside = info.within_bars(bars)
