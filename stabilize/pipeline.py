@@ -44,7 +44,7 @@ from stabilize.path.zoom import CROP_MODES
 from stabilize.progress import ProgressFactory, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoInfo, atomic_output, frame_interval, frame_times, probe
-from stabilize.video.bars import detect_bars
+from stabilize.video.bars import BARS_MODES, detect_bars
 from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Mux
 from stabilize.video.fields import DEINTERLACE_MODES
@@ -364,7 +364,7 @@ def check_settings(settings: Settings) -> None:
             settings.deinterlace in DEINTERLACE_MODES,
             f"--deinterlace must be one of {', '.join(DEINTERLACE_MODES)}",
         ),
-        (settings.bars in ("auto", "off"), "--bars must be auto or off"),
+        (settings.bars in BARS_MODES, f"--bars must be one of {', '.join(BARS_MODES)}"),
         (
             settings.fov in (None, "auto")
             or (isinstance(settings.fov, int | float) and 0 < settings.fov < 180),

@@ -24,6 +24,7 @@ from stabilize.path.residual import MOTION_MODELS
 from stabilize.path.smoothing import METHODS
 from stabilize.path.zoom import CROP_MODES
 from stabilize.settings import DEFAULTS, Settings
+from stabilize.video.bars import BARS_MODES
 from stabilize.video.encode import Encoding
 from stabilize.video.fields import DEINTERLACE_MODES
 
@@ -103,7 +104,7 @@ DeinterlaceOption = Annotated[
     ),
 ]
 BarsOption = Annotated[
-    Literal["auto", "off"],
+    Literal[BARS_MODES],
     typer.Option(
         help="Black bars baked into the frame (letterbox, pillarbox): auto stabilises the "
         "picture inside them and keeps them still; off warps them with it."

@@ -37,6 +37,7 @@ MIN_BAR = 0.02  # of its side: a thinner black edge is the picture's, or an enco
 PAIR = 0.01  # of its side: how far a letterbox's or pillarbox's two bars may differ
 MIN_PICTURE = 0.25  # of each side: a 9:16 picture in a 16:9 frame spans 0.32 of it
 SAMPLES = 3  # frames read at the least
+BARS_MODES = ("auto", "off")  # --bars: the picture inside them stabilised alone, or not
 
 # the extents of what is not black, over every frame read so far (reset=0)
 _EXTENT = re.compile(r"Parsed_cropdetect.*? x1:(\d+) x2:(\d+) y1:(\d+) y2:(\d+)")
