@@ -158,11 +158,8 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
         from stabilize.gyro.load import load_gyro
 
         log = load_gyro(settings)
-    # the sensor's rows, whichever way the camera was held; its fields woven into frames;
-    # the picture inside black bars baked into the frame
+    # the sensor's rows, whichever way the camera was held; its fields woven into frames
     info = probe(src).stored().deinterlaced(settings.deinterlace)
-    if settings.bars == "auto" and not settings.lens:  # a lens's frame is the sensor's
-        info = info.within_bars(detect_bars(info))
     check_writable(dst)
     check_encoder(dst, settings.encoding, encoded_size(info, settings))
     lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
@@ -172,9 +169,14 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
         from stabilize.gyro.readers import sensor_frame_times
 
         stamps = sensor_frame_times(settings.gyro_timestamps, 0, len(times))
-    mux = keep_streams(info, container_for(dst), info.video_delay)
+    # Last, once every check has passed (it decodes frames): the picture inside black
+    # bars baked into the frame. A lens's frame is the sensor's, bars or not.
+    if settings.bars == "auto" and not settings.lens:
+        info = info.within_bars(detect_bars(info))
+    container = container_for(dst)
+    mux = keep_streams(info, container, info.video_delay)
     notices = mux.notices + fields_notice(info) + pixels_notice(info) + bars_notice(info)
-    codec = settings.encoding.codec_for(container_for(dst))
+    codec = settings.encoding.codec_for(container)
     if info.colour.hdr10_lost(codec):
         notices += (
             f"HDR10's mastering display and light levels left out: {codec} does not write "
