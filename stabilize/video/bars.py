@@ -20,14 +20,13 @@ side (a 9:16 picture pillarboxed into a 16:9 frame spans 0.32 of its width).
 from __future__ import annotations
 
 import re
-import subprocess
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
 from stabilize.video import i420
-from stabilize.video.binary import ffmpeg_exe
+from stabilize.video.binary import filter_log
 from stabilize.video.probe import VideoInfo
 
 # cropdetect's limit, of 255: brighter than the range's black (16 limited, 0 full) by
@@ -67,10 +66,8 @@ def _cropdetect(
     path: str | Path, options: list[str], reading: list[str], chain: list[str]
 ) -> list[tuple[int, int, int, int]]:
     """cropdetect's running extents, frame by frame, as (x1, x2, y1, y2)."""
-    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *reading, *options, "-i", str(path)]
-    cmd += ["-map", "0:v:0", "-vf", ",".join(chain), "-f", "null", "-"]
-    result = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
-    return [tuple(map(int, m.groups())) for m in _EXTENT.finditer(result.stderr)]
+    log = filter_log(path, ",".join(chain), (*reading, *options))
+    return [tuple(map(int, m.groups())) for m in _EXTENT.finditer(log)]
 
 
 def _letterbox(

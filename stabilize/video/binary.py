@@ -8,6 +8,9 @@ from __future__ import annotations
 
 import functools
 import shutil
+import subprocess
+from collections.abc import Sequence
+from pathlib import Path
 
 
 @functools.cache
@@ -32,3 +35,14 @@ def widen_pipe(stream) -> None:
         fcntl.fcntl(stream.fileno(), getattr(fcntl, "F_SETPIPE_SZ", 1031), PIPE_BYTES)
     except (ImportError, OSError, ValueError):
         pass
+
+
+def filter_log(
+    path: str | Path, chain: str, before: Sequence[str] = (), after: Sequence[str] = ()
+) -> str:
+    """What FFmpeg's video filters ``chain`` log (its stderr) over the first video
+    stream of ``path``, decoded and thrown away: ``before`` are input options (which
+    frames to decode), ``after`` output ones (how many to pass)."""
+    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *before, "-i", str(path)]
+    cmd += ["-map", "0:v:0", "-vf", chain, *after, "-f", "null", "-"]
+    return subprocess.run(cmd, capture_output=True, text=True, errors="replace").stderr

@@ -9,16 +9,13 @@ only where the header leaves one of them open.
 
 from __future__ import annotations
 
-import subprocess
 from pathlib import Path
 
-from stabilize.video.binary import ffmpeg_exe
+from stabilize.video.binary import filter_log
 
 
 def first_frame_report(path: str | Path, input_args: tuple = ()) -> str:
     """FFmpeg's ``showinfo`` lines for the first frame of the first video stream (its
     flags, its side data), or ``""`` where none decodes."""
-    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i", str(path)]
-    cmd += ["-map", "0:v:0", "-vf", "showinfo", "-frames:v", "1", "-f", "null", "-"]
-    result = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
-    return "\n".join(line for line in result.stderr.splitlines() if "Parsed_showinfo" in line)
+    log = filter_log(path, "showinfo", input_args, ("-frames:v", "1"))
+    return "\n".join(line for line in log.splitlines() if "Parsed_showinfo" in line)
