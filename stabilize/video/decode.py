@@ -41,8 +41,7 @@ def read_frames(
     if not info.autorotate:
         options["noautorotate"] = None
     dh, dw = info.decoded_size
-    resample = (h, w) != (dh, dw)  # to the working size, or an anamorphic stream's pixels
-    shrink = resample and h <= dh and w <= dw
+    shrink = (h, w) != (dh, dw) and h <= dh and w <= dw
     if shrink and size is not None:
         # Deblocking only smooths detail that the downscale to a working size averages
         # away anyway; skipping it makes the decode about 20% faster. (Not where only an
@@ -52,15 +51,15 @@ def read_frames(
     if info.deinterlace:  # before any scaling, which would blend the fields
         name, fields = deinterlace_filter(every_frame=not interlaced(info.field_order))
         stream = stream.filter(name, **fields)
-    if info.bars:  # the picture inside them, in square pixels, then at ``size``
+    source = (dh, dw)
+    if info.bars:  # the picture inside them, in square pixels
         fh, fw = info.framed_size
-        if (fh, fw) != (dh, dw):
+        if (fh, fw) != source:
             stream = stream.filter("scale", fw, fh, flags="bicubic").filter("setsar", "1")
         top, _, left, _ = info.bars
         stream = stream.filter("crop", info.width, info.height, left, top)
-        if (h, w) != info.size:
-            stream = stream.filter("scale", w, h, flags="area" if shrink else "bicubic")
-    elif resample:
+        source = info.size
+    if (h, w) != source:  # to the working size, or an anamorphic stream's pixels
         stream = stream.filter("scale", w, h, flags="area" if shrink else "bicubic")
         stream = stream.filter("setsar", "1")
     process = (
