@@ -45,14 +45,15 @@ from stabilize.progress import ProgressFactory, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoInfo, atomic_output, frame_interval, frame_times, probe
 from stabilize.video.bars import BARS_MODES, detect_bars
+from stabilize.video.colour import DOLBY_BASE
 from stabilize.video.containers import container_for
-from stabilize.video.encode import EncodeError, Mux
+from stabilize.video.encode import EncodeError, Encoding, Mux
 from stabilize.video.fields import DEINTERLACE_MODES
 from stabilize.video.preflight import check_encoder, check_writable, describe
 from stabilize.video.streams import keep_streams
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.lens import Lens, read_lens_profile
-from stabilize.warp.render import encoded_size, frame_size, render
+from stabilize.warp.render import encoded_size, frame_size, output_encoding, render
 from stabilize.warp.rolling import RAMP_S, within_stretch
 
 
@@ -66,6 +67,7 @@ class Job:
     log: GyroLog | None
     stamps: NDArray | None  # the frames' times on the gyro clock (--gyro-timestamps)
     mux: Mux
+    encoding: Encoding  # the output's encoder and pixel format, as the source's depth asks
     notices: tuple[str, ...]
 
 
@@ -124,6 +126,7 @@ def stabilize_video(
         "bars": None if job.info.bars is None else list(job.info.bars),  # top, bottom, left, right
         "field_order": job.info.field_order or None,  # the input's: tff, bff, progressive
         "deinterlaced": job.info.deinterlace,
+        "encoder": {"codec": job.encoding.codec, "pix_fmt": job.encoding.pix_fmt},
         "focal_px": float(K[0, 0]),
         "focal": focal.summary(),
         "zoom": float(planned.zoom.max()),
@@ -161,7 +164,9 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     # the sensor's rows, whichever way the camera was held; its fields woven into frames
     info = probe(src).stored().deinterlaced(settings.deinterlace)
     check_writable(dst)
-    check_encoder(dst, settings.encoding, encoded_size(info, settings))
+    container = container_for(dst)
+    encoding = output_encoding(info, settings, container)
+    check_encoder(dst, encoding, encoded_size(info, settings))
     lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
     times = frame_times(src, info.input_args)  # read once: the packets, not the pixels
     stamps = None
@@ -173,14 +178,14 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     # bars baked into the frame. A lens's frame is the sensor's, bars or not.
     if settings.bars == "auto" and not settings.lens:
         info = info.within_bars(detect_bars(info))
-    container = container_for(dst)
     mux = keep_streams(info, container, info.video_delay)
     notices = mux.notices + fields_notice(info) + pixels_notice(info) + bars_notice(info)
-    codec = settings.encoding.codec_for(container)
-    if info.colour.hdr10_lost(codec):
+    notices += encoder_notice(encoding, settings.encoding.codec_for(container))
+    notices += dolby_vision_notice(info.colour.dolby_vision)
+    if info.colour.hdr10_lost(encoding.codec):
         notices += (
-            f"HDR10's mastering display and light levels left out: {codec} does not write "
-            "them (libx264 and libx265 do)",
+            f"HDR10's mastering display and light levels left out: {encoding.codec} does "
+            "not write them (libx264 and libx265 do)",
         )
     if not settings.size and frame_size(info, settings) != info.shown_framed_size:
         (h, w), (sh, sw) = frame_size(info, settings), info.shown_framed_size
@@ -188,7 +193,33 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
             f"{sw}x{sh} has an odd side: the output is {w}x{h}, the last row or column "
             "cropped (4:2:0 video needs even sides)",
         )
-    return Job(info, times, lens, log, stamps, mux, notices)
+    return Job(info, times, lens, log, stamps, mux, encoding, notices)
+
+
+def encoder_notice(encoding: Encoding, default: str) -> tuple[str, ...]:
+    """A notice where a deep source's output is encoded by another encoder than the
+    container's default (HEVC, not H.264: :meth:`Encoding.for_frames`)."""
+    if encoding.codec == default:
+        return ()
+    return (
+        f"10-bit video: encoded with {encoding.codec}, which phones and most browsers play "
+        f"at 10 bits, where {default} at 10 bits plays in few players (--codec {default} "
+        "keeps it)",
+    )
+
+
+def dolby_vision_notice(profile: str | None) -> tuple[str, ...]:
+    """A notice where a Dolby Vision stream's metadata is left out, naming what its
+    picture is without it (:data:`stabilize.video.colour.DOLBY_BASE`)."""
+    if profile is None:
+        return ()
+    base = DOLBY_BASE.get(profile.split(".")[1])
+    kept = (
+        f"its {base} picture is kept, and plays as that"
+        if base
+        else "its picture is in Dolby's own colours, which look wrong without it"
+    )
+    return (f"Dolby Vision (profile {profile}) left out, its metadata does not travel: {kept}",)
 
 
 def fields_notice(info: VideoInfo) -> tuple[str, ...]:

@@ -56,6 +56,10 @@ class Colour:
     # 1/10000 cd/m²), and the content light levels "MaxCLL,MaxFALL" (cd/m²)
     mastering: str | None = None
     light: str | None = None
+    # Dolby Vision, as "profile.compatibility" (an iPhone's HDR clip: "8.4", HLG inside);
+    # its per-frame metadata does not travel through the pipe, so only its base layer
+    # (:data:`DOLBY_BASE`) is kept
+    dolby_vision: str | None = None
 
     @property
     def full_range(self) -> bool:
@@ -101,6 +105,27 @@ class Colour:
 
 
 UNKNOWN = Colour()  # a source that says nothing: the encoder's defaults
+
+# What a player shows of a Dolby Vision stream without its metadata, by the base layer's
+# signal compatibility id; 0 (profile 5) is Dolby's own IPT colour space, which no player
+# shows right without it
+DOLBY_BASE = {"1": "HDR10", "2": "SDR (BT.709)", "4": "HLG", "6": "HDR10"}
+_DOVI = re.compile(r"DOVI configuration record: .*?profile: (\d+).*?compatibility id: (\d+)")
+
+
+def dolby_vision(listing: str) -> str | None:
+    """The Dolby Vision profile FFmpeg lists for a stream, as "profile.compatibility";
+    None where it lists none.
+
+    >>> dolby_vision("      DOVI configuration record: version: 1.0, profile: 8, level: 4, "
+    ...              "rpu flag: 1, el flag: 0, bl flag: 1, compatibility id: 4")
+    '8.4'
+    >>> dolby_vision("  Stream #0:0: Video: hevc (Main 10), yuv420p10le") is None
+    True
+    """
+    m = _DOVI.search(listing)
+    return f"{m.group(1)}.{m.group(2)}" if m else None
+
 
 _MASTERING = re.compile(
     r"Mastering display metadata: has_primaries:1 has_luminance:1 "

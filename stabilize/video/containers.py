@@ -36,6 +36,10 @@ class Container:
     chapters: bool = True
     options: tuple[str, ...] = ()
     hevc_tag: str | None = None  # the codec tag Apple players need for HEVC
+    # The default encoder for a source of 10 bits or more, where the default one's 10-bit
+    # output plays in few players (None: the default one): H.264 at 10 bits (High 10)
+    # plays neither on Apple's devices nor in most browsers, HEVC at 10 bits in both
+    deep_encoder: str | None = None
     data: frozenset[str] = frozenset()  # data tracks held as they are, by codec tag
     # Where a start timecode goes: "track" (written again from the video's timecode tag
     # as a tmcd track, as QuickTime does), "tag" (kept as the video's tag), "" (nowhere)
@@ -59,6 +63,7 @@ MP4 = Container(
     subtitle_encoder="mov_text",
     options=QUICKTIME,
     hevc_tag="hvc1",
+    deep_encoder="libx265",
     data=frozenset({"gpmd"}),  # GoPro's GPMF telemetry (its gyro): telemetry-parser reads it back
     timecode="track",
 )
@@ -74,6 +79,7 @@ CONTAINERS: dict[str, Container] = {
             {"subrip", "ass", "ssa", "webvtt", "hdmv_pgs_subtitle", "dvd_subtitle", "dvb_subtitle"}
         ),
         subtitle_encoder="srt",
+        deep_encoder="libx265",
         timecode="tag",
     ),
     ".webm": Container(
@@ -97,6 +103,7 @@ CONTAINERS: dict[str, Container] = {
         audio=frozenset({"aac", "mp3", "mp2", "ac3", "eac3", "opus"}),
         subtitles=frozenset({"dvb_subtitle"}),
         chapters=False,
+        deep_encoder="libx265",
     ),
 }
 

@@ -29,7 +29,8 @@ class EncodeError(RuntimeError):
 @dataclass(frozen=True)
 class Encoding:
     """How the video stream is encoded. ``codec`` None: the container's default encoder
-    (libx264, or VP9 for WebM); ``crf`` None: that encoder's default quality (x264: 18)."""
+    (libx264, or VP9 for WebM; for a source of 10 bits or more, HEVC: :meth:`for_frames`);
+    ``crf`` None: that encoder's default quality (x264: 18)."""
 
     codec: str | None = None
     crf: int | None = None
@@ -41,6 +42,28 @@ class Encoding:
     def codec_for(self, container: Container) -> str:
         """The encoder to use in ``container``."""
         return self.codec or container.video_encoder
+
+    def for_frames(self, container: Container, pix_fmt_in: str) -> Encoding:
+        """This encoding made whole for frames piped as ``pix_fmt_in`` into ``container``.
+
+        A 10-bit pipe (``yuv420p10le``) is encoded at 10 bits, by the container's encoder
+        for deep sources where none is asked for: HEVC in MP4, MOV, MKV and TS, since
+        H.264 at 10 bits plays neither on Apple's devices nor in most browsers.
+
+        >>> from stabilize.video.containers import container_for
+        >>> deep = Encoding().for_frames(container_for("a.mov"), "yuv420p10le")
+        >>> deep.codec, deep.pix_fmt
+        ('libx265', 'yuv420p10le')
+        >>> Encoding().for_frames(container_for("a.mov"), "yuv420p").codec
+        'libx264'
+        >>> Encoding(codec="libx264").for_frames(container_for("a.mov"), "yuv420p10le").codec
+        'libx264'
+        """
+        if pix_fmt_in != "yuv420p10le":
+            return replace(self, codec=self.codec_for(container))
+        codec = self.codec or container.deep_encoder or container.video_encoder
+        pix_fmt = pix_fmt_in if self.pix_fmt == "yuv420p" else self.pix_fmt
+        return replace(self, codec=codec, pix_fmt=pix_fmt)
 
 
 @dataclass(frozen=True)

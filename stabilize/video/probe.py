@@ -13,7 +13,7 @@ from fractions import Fraction
 from pathlib import Path
 
 from stabilize.video.binary import ffmpeg_exe
-from stabilize.video.colour import UNKNOWN, Colour, colour_of, with_hdr10
+from stabilize.video.colour import UNKNOWN, Colour, colour_of, dolby_vision, with_hdr10
 from stabilize.video.fields import DEINTERLACE_MODES, field_order, frame_field_order, interlaced
 from stabilize.video.first_frame import first_frame_report
 from stabilize.video.i420 import pipe_format
@@ -165,10 +165,16 @@ _SAR = re.compile(r"\[SAR (\d+):(\d+) DAR")
 _ROTATION = re.compile(r"rotation of (-?\d+(?:\.\d+)?) degrees|rotate\s*:\s*(-?\d+)")
 
 
+def _listing(text: str, start: int) -> str:
+    """What FFmpeg lists of the stream whose line starts at ``start``: its line, its
+    Metadata and Side data lines, up to the next stream (indented deeper within a stream
+    group)."""
+    return re.split(r"\n\s*Stream #", text[start:], maxsplit=1)[0]
+
+
 def _stream(match: re.Match, text: str) -> Stream:
     line = text[match.start() : text.find("\n", match.start())]
-    # its Metadata: lines, up to the next stream (indented deeper within a stream group)
-    block = re.split(r"\n\s*Stream #", text[match.end() :], maxsplit=1)[0]
+    block = _listing(text, match.start())
     title = re.search(r"^\s+(?:title|name)\s*: (.*)$", block, re.M)
     start = re.search(r", start (-?\d+(?:\.\d+)?)", line)
     tag = re.search(r"\((\w+) / 0x[0-9A-Fa-f]+\)", line)
@@ -251,6 +257,7 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
         w, h = h, w
         coded = coded and coded[::-1]
     order, colour = _from_frames(path, input_args, pix_fmt, video.group(3) or "")
+    colour = replace(colour, dolby_vision=dolby_vision(_listing(text, video.start())))
     streams = tuple(_stream(m, text) for m in _STREAM.finditer(text))
     has_audio = any(s.kind == "audio" for s in streams)
     start = _START.search(text)

@@ -20,8 +20,8 @@ from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
 from stabilize.video import FrameWriter, VideoInfo, i420, read_frames
 from stabilize.video.bars import put_back
-from stabilize.video.containers import container_for
-from stabilize.video.encode import Mux
+from stabilize.video.containers import Container, container_for
+from stabilize.video.encode import Encoding, Mux
 from stabilize.video.retime import is_variable_rate, retime
 from stabilize.video.turn import turn
 from stabilize.warp.camera_path import CameraPath
@@ -53,13 +53,11 @@ def render(
     h, w = frame_size(info, settings)
     size = encoded_size(info, settings)
     variable = is_variable_rate(planned.times)
-    encoding = replace(settings.encoding, b_frames=False) if variable else settings.encoding
+    pix_fmt = piped_format(info, settings)
+    planar = pix_fmt != "rgb24"
+    encoding = output_encoding(info, settings, container)
+    encoding = replace(encoding, b_frames=False) if variable else encoding
     target = out.with_name(f"{out.stem}.cfr{out.suffix}") if variable else out
-    # I420 end to end where the size allows: no colour conversions, half the bytes.
-    planar = i420.supports(info.size) and i420.supports((h, w))
-    pix_fmt = i420.pipe_format(info.pix_fmt) if planar else "rgb24"
-    if pix_fmt == "yuv420p10le" and encoding.pix_fmt == "yuv420p":
-        encoding = replace(encoding, pix_fmt=pix_fmt)  # keep a 10-bit source's depth
     side_by_side = i420.hstack if planar else lambda a, b: np.hstack([a, b])
     resize = resize_planes if planar else resize_image
 
@@ -113,6 +111,20 @@ def frame_size(info: VideoInfo, settings: Settings) -> tuple[int, int]:
     the smallest loss, and at the frame's edge, which the zoom crops anyway)."""
     h, w = settings.size or info.shown_framed_size
     return h - h % 2, w - w % 2
+
+
+def piped_format(info: VideoInfo, settings: Settings) -> str:
+    """FFmpeg's format of the frames piped to the encoder: I420 at the source's depth (8
+    or 10 bits) where the frames' sizes allow, so there are no colour conversions and
+    half the bytes travel; else RGB."""
+    planar = i420.supports(info.size) and i420.supports(frame_size(info, settings))
+    return i420.pipe_format(info.pix_fmt) if planar else "rgb24"
+
+
+def output_encoding(info: VideoInfo, settings: Settings, container: Container) -> Encoding:
+    """The encoder and pixel format the output is written with: ``--codec``, else the
+    container's default for the source's depth (:meth:`Encoding.for_frames`)."""
+    return settings.encoding.for_frames(container, piped_format(info, settings))
 
 
 def encoded_size(info: VideoInfo, settings: Settings) -> tuple[int, int]:

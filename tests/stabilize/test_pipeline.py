@@ -13,7 +13,7 @@ from rotation import so3
 from stabilize import Settings, stabilize_video
 from stabilize.motion.focal import initial_focal
 from stabilize.synth import SynthOptions, trajectory
-from stabilize.video import ffmpeg_exe, frame_times, probe, read_frames
+from stabilize.video import Encoding, ffmpeg_exe, frame_times, probe, read_frames
 from tests.stabilize.conftest import render
 from tests.stabilize.helpers import boxed, combing, held_upright, squeezed, woven
 
@@ -186,6 +186,22 @@ def test_a_deep_source_stays_10_bit(shaky, tmp_path, name, encode):
     assert probe(out).pix_fmt.startswith("yuv420p10") and summary["frames"] == 60
     frames = list(read_frames(out))
     assert len(frames) == 60 and min(f.mean() for f in frames) > 20  # content, not black
+    # HEVC, which Apple's devices and browsers play at 10 bits, where H.264 plays in few
+    written = probe(out)
+    assert (written.codec, written.streams[0].tag) == ("hevc", "hvc1")
+    assert summary["encoder"] == {"codec": "libx265", "pix_fmt": "yuv420p10le"}
+    assert any(n.startswith("10-bit video: encoded with libx265") for n in summary["notices"])
+
+
+def test_a_deep_source_keeps_the_encoder_asked_for(shaky, tmp_path):
+    ten = tmp_path / "ten.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-t", "1", "-c:v", "libx264"]
+    subprocess.run([*cmd, "-pix_fmt", "yuv420p10le", str(ten)], check=True)
+    out = tmp_path / "out.mkv"
+    settings = Settings(fov=70.0, encoding=Encoding(codec="libx264", preset="ultrafast"))
+    summary, _ = stabilize_video(ten, out, settings)
+    assert (probe(out).codec, probe(out).pix_fmt) == ("h264", "yuv420p10le")
+    assert not any(n.startswith("10-bit video") for n in summary["notices"])
 
 
 def test_the_public_api_names_the_job_and_its_stages():

@@ -11,6 +11,7 @@ import pytest
 from numpy.typing import NDArray
 
 from stabilize import Settings, stabilize_video
+from stabilize.pipeline import dolby_vision_notice
 from stabilize.video import Encoding, ffmpeg_exe, probe, read_frames
 from stabilize.video.colour import Colour, colour_of
 from stabilize.video.i420 import black
@@ -91,8 +92,11 @@ def test_borders_are_black_in_full_range(shaky, tmp_path):
 
 def test_a_source_that_says_nothing_gets_the_encoders_defaults(shaky, tmp_path):
     out = tmp_path / "out.mp4"
-    stabilize_video(shaky, out, Settings())
+    summary, _ = stabilize_video(shaky, out, Settings())
     assert probe(out).colour.range in (None, "tv")
+    # 8 bits: H.264, which every player plays
+    assert summary["encoder"] == {"codec": "libx264", "pix_fmt": "yuv420p"}
+    assert probe(out).codec == "h264"
 
 
 MASTERING = "G(13250,34500)B(7500,3000)R(34000,16000)WP(15635,16450)L(10000000,50)"
@@ -125,3 +129,49 @@ def test_hdr10_metadata_is_read_and_written_again(hdr10, tmp_path, codec):
 def test_hdr10_metadata_an_encoder_cannot_write_is_said_lost(hdr10, tmp_path):
     summary, _ = stabilize_video(hdr10, tmp_path / "out.webm", Settings(fov=70.0))
     assert any("HDR10's mastering display" in n for n in summary["notices"])
+
+
+@pytest.mark.parametrize(
+    ("profile", "said"),
+    [
+        ("8.4", "its HLG picture is kept"),  # an iPhone's HDR clip
+        ("8.1", "its HDR10 picture is kept"),
+        ("5.0", "Dolby's own colours, which look wrong"),  # no picture outside it
+    ],
+)
+def test_dolby_vision_left_out_is_said_with_what_its_picture_is(profile, said):
+    (notice,) = dolby_vision_notice(profile)
+    assert notice.startswith(f"Dolby Vision (profile {profile}) left out") and said in notice
+    assert dolby_vision_notice(None) == ()
+
+
+IPHONE_HDR = """Input #0, mov,mp4,m4a,3gp,3g2,mj2, from 'IMG_0001.MOV':
+  Duration: 00:00:02.00, start: 0.000000, bitrate: 20000 kb/s
+  Stream #0:0[0x1](und): Video: hevc (Main 10) (hvc1 / 0x31637668), yuv420p10le(tv, \
+bt2020nc/bt2020/arib-std-b67), 1920x1080, 19000 kb/s, 30 fps, 30 tbr, 600 tbn (default)
+      Metadata:
+        handler_name    : Core Media Video
+      Side data:
+        DOVI configuration record: version: 1.0, profile: 8, level: 4, rpu flag: 1, \
+el flag: 0, bl flag: 1, compatibility id: 4
+  Stream #0:1[0x2](und): Audio: aac (LC) (mp4a / 0x6134706D), 44100 Hz, stereo, fltp
+"""
+
+
+def test_dolby_vision_is_read_from_the_video_streams_own_listing(tmp_path, monkeypatch):
+    clip = tmp_path / "IMG_0001.MOV"
+    clip.write_bytes(b"")
+
+    def listed(text):  # FFmpeg's listing of the file, and of its first frame
+        result = subprocess.CompletedProcess([], 1, "", text)
+        monkeypatch.setattr(subprocess, "run", lambda *a, **k: result)
+        return probe(clip).colour
+
+    assert listed(IPHONE_HDR).dolby_vision == "8.4"
+    assert listed(IPHONE_HDR).transfer == "arib-std-b67"
+    # a record of another stream's (here a second video stream's) is not the first's
+    video, record = IPHONE_HDR.split("      Side data:\n")
+    record, audio = record.split("  Stream #0:1")
+    second = video.replace("#0:0[0x1]", "#0:1[0x2]") + "      Side data:\n" + record
+    plain = video + second + "  Stream #0:2" + audio
+    assert listed(plain).dolby_vision is None
