@@ -50,6 +50,7 @@ from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Encoding, Mux
 from stabilize.video.fields import DEINTERLACE_MODES
 from stabilize.video.preflight import check_encoder, check_writable, describe
+from stabilize.video.probe import first_image, sequence_args
 from stabilize.video.streams import keep_streams
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.lens import Lens, read_lens_profile
@@ -162,7 +163,8 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
 
         log = load_gyro(settings)
     # the sensor's rows, whichever way the camera was held; its fields woven into frames
-    info = probe(src).stored().deinterlaced(settings.deinterlace)
+    info = probe(src, sequence_args(src, fps=settings.fps))
+    info = info.stored().deinterlaced(settings.deinterlace)
     check_writable(dst)
     container = container_for(dst)
     encoding = output_encoding(info, settings, container)
@@ -171,9 +173,10 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     times = frame_times(src, info.input_args)  # read once: the packets, not the pixels
     stamps = None
     if settings.gyro_timestamps:
-        from stabilize.gyro.readers import sensor_frame_times
+        from stabilize.gyro.readers import first_stamp, sensor_frame_times
 
-        stamps = sensor_frame_times(settings.gyro_timestamps, 0, len(times))
+        first = first_stamp(first_image(info.input_args))
+        stamps = sensor_frame_times(settings.gyro_timestamps, first, len(times))
     # Last, once every check has passed (it decodes frames): the picture inside black
     # bars baked into the frame. A lens's frame is the sensor's, bars or not.
     if settings.bars == "auto" and not settings.lens:
@@ -407,6 +410,7 @@ def check_settings(settings: Settings) -> None:
         (settings.smooth > 0, "--smooth must be positive"),
         (settings.max_zoom >= 1.0, "--max-zoom must be at least 1"),
         (settings.gyro_search >= 0, "--gyro-search must not be negative"),
+        (settings.fps is None or settings.fps > 0, "--fps must be positive"),
         (0 <= settings.max_stretch <= 100, "--max-stretch must be 0–100 %"),
         (
             settings.rolling_shutter in ("auto", "off")
@@ -437,7 +441,10 @@ def settings_summary(settings: Settings) -> dict:
 
 def _check_output(src: Path, dst: Path, overwrite: bool) -> None:
     """Refuse an output that is the input, or that exists without ``overwrite``."""
-    same = src.resolve() == dst.resolve() or (dst.exists() and os.path.samefile(src, dst))
+    # an image sequence's pattern names no one file
+    same = src.resolve() == dst.resolve() or (
+        dst.exists() and src.exists() and os.path.samefile(src, dst)
+    )
     if same:
         raise ValueError(f"the output {dst} is the input; choose another name")
     if dst.exists() and not overwrite:

@@ -77,6 +77,9 @@ class Settings:
     # black bars baked into the frame (stabilize.video.bars): 'auto' stabilises the
     # picture inside them and keeps them still, 'off' warps them with it
     bars: str = "auto"
+    # an image-sequence input's frame rate (frames/img-%d.jpg); None: 30. A video's own
+    # frame times are always used
+    fps: float | None = None
     encoding: Encoding = field(default_factory=Encoding)
 
     def focal_px(self, size: tuple[int, int]) -> float:

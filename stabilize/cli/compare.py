@@ -17,6 +17,7 @@ from stabilize.cli.options import (
     FlowOption,
     FocalOption,
     FovOption,
+    FpsOption,
     GyroAxesOption,
     GyroDriftOption,
     GyroFormatOption,
@@ -41,7 +42,7 @@ from stabilize.video.probe import VideoInfo
     epilog=(
         "Examples:\n\n"
         "  stabilize compare clip.mp4 --gyro gyro.csv --report cmp/\n\n"
-        "  stabilize compare 'frames/RE_frame-%d.jpg' --start-number 99 --gyro gyro.txt "
+        "  stabilize compare 'frames/RE_frame-%d.jpg' --gyro gyro.txt "
         "--gyro-timestamps framestamp.txt --focal 573.85 --json\n\n"
         "  stabilize compare clip.mp4 --gyro log.gcsv --gyro-offset 0.042 --gyro-axes YXz\n\n"
         "  stabilize compare clip.mp4 --gyro gyro.csv --calibrate-focal --gyro-drift"
@@ -53,8 +54,10 @@ def compare(
     gyro: Path = typer.Option(..., help="The gyro log."),
     gyro_format: GyroFormatOption = None,
     gyro_timestamps: GyroTimestampsOption = None,
-    start_number: int | None = typer.Option(None, help="First image number of a pattern."),
-    fps: float | None = typer.Option(None, help="Frame rate of an image sequence."),
+    start_number: int | None = typer.Option(
+        None, help="First image number of a pattern (default: the lowest its files carry)."
+    ),
+    fps: FpsOption = None,
     fov: FovOption = DEFAULTS.fov,
     focal: FocalOption = DEFAULTS.focal,
     lens: LensOption = None,
@@ -175,9 +178,10 @@ def _video_and_times(
     info = probe(video, args).stored()  # the sensor's rows and axes, however it was held
     times = frame_times(video, args)
     if timestamps is not None:
-        from stabilize.gyro.readers import sensor_frame_times
+        from stabilize.gyro.readers import first_stamp, sensor_frame_times
+        from stabilize.video.probe import first_image
 
-        first = (start_number or 1) - 1 if args else 0
+        first = first_stamp(first_image(info.input_args))
         times = sensor_frame_times(timestamps, first, len(times))
     return info, times
 

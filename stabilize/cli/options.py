@@ -150,6 +150,12 @@ GyroTimestampsOption = Annotated[
         help="Frame times on the gyro clock (OpenCamera ns, or seconds per line).",
     ),
 ]
+FpsOption = Annotated[
+    float | None,
+    typer.Option(
+        min=0.01, help="Frame rate of an image-sequence input (frames/img-%d.jpg); default 30."
+    ),
+]
 GyroLpfOption = Annotated[float | None, typer.Option(help="Low-pass the gyro at this many Hz.")]
 GyroDriftOption = Annotated[bool, typer.Option("--gyro-drift", help="Also fit a clock drift.")]
 ReadoutOption = Annotated[
@@ -228,6 +234,7 @@ def job_settings(params: Mapping[str, Any]) -> Settings:
         gyro_axes=None if axes is None else tuple(map(tuple, axes_matrix(axes))),
         gyro_timestamps=str(stamps) if (stamps := params.get("gyro_timestamps")) else None,
         gyro_search=params.get("gyro_search", GYRO_SEARCH),
+        fps=params.get("fps"),
     )
 
 

@@ -12,6 +12,7 @@ from stabilize.cli.options import (
     FlowOption,
     FocalOption,
     FovOption,
+    FpsOption,
     OverwriteOption,
     QuietOption,
     RaftWeightsOption,
@@ -30,7 +31,9 @@ from stabilize.settings import DEFAULTS
     )
 )
 def rotations(
-    input_path: Path = typer.Argument(..., metavar="IN", help="A video."),
+    input_path: Path = typer.Argument(
+        ..., metavar="IN", help="A video, or an image sequence (frames/img-%d.jpg)."
+    ),
     output: Path | None = typer.Option(
         None, "-o", "--output", help="CSV: frame,t,rx,ry,rz,support."
     ),
@@ -42,6 +45,7 @@ def rotations(
     device: DeviceOption = DEFAULTS.device,
     fov: FovOption = DEFAULTS.fov,
     focal: FocalOption = DEFAULTS.focal,
+    fps: FpsOption = None,
     overwrite: OverwriteOption = False,
     quiet: QuietOption = False,
 ) -> None:
@@ -52,7 +56,7 @@ def rotations(
     from stabilize.cli.bars import with_bars
     from stabilize.motion.files import write_rotations
     from stabilize.motion.focal import estimate_motion
-    from stabilize.video import atomic_output, probe
+    from stabilize.video import atomic_output, probe, sequence_args
     from stabilize.video.preflight import check_writable
 
     if output is None and gcsv is None:
@@ -63,7 +67,8 @@ def rotations(
             fail(f"{target} exists (use --overwrite to replace it)")
         run_or_fail(lambda target=target: check_writable(target))
     settings = flow_settings(flow_name, raft_weights, device, fov=field_of_view(fov), focal=focal)
-    info = run_or_fail(lambda: probe(input_path).stored())  # the sensor's axes, as compare's
+    # the sensor's axes, as compare's
+    info = run_or_fail(lambda: probe(input_path, sequence_args(input_path, fps=fps)).stored())
 
     def estimate(bar):
         return estimate_motion(input_path, info, settings, bar("estimating", None))

@@ -21,6 +21,7 @@ from stabilize.cli.options import (
     FlowOption,
     FocalOption,
     FovOption,
+    FpsOption,
     GyroAxesOption,
     GyroDriftOption,
     GyroFormatOption,
@@ -57,13 +58,16 @@ from stabilize.settings import DEFAULTS
         "  stabilize shaky.mp4 steady.mp4\n\n"
         "  stabilize shaky.mp4 steady.mp4 --smooth 1.0 --max-zoom 1.3 --report report/\n\n"
         "  stabilize drone.mp4 locked.mp4 --lock --crop dynamic\n\n"
+        "  stabilize 'frames/img-%05d.jpg' steady.mp4 --fps 30\n\n"
         "  stabilize gopro.mp4 out.mp4 --lens 'GoPro_HERO7 Black_Wide_16by9.json'\n\n"
         "  stabilize in.mp4 out.mp4 --flow raft --raft-weights raft-small.pth --device cuda"
     ),
 )
 def run(
     ctx: typer.Context,
-    input_path: Path = typer.Argument(..., metavar="IN", help="The shaky video."),
+    input_path: Path = typer.Argument(
+        ..., metavar="IN", help="The shaky video, or an image sequence (frames/img-%d.jpg)."
+    ),
     output_path: Path = typer.Argument(..., metavar="OUT", help="Where to write the result."),
     flow_name: FlowOption = DEFAULTS.flow,
     raft_weights: RaftWeightsOption = None,
@@ -87,6 +91,7 @@ def run(
     size: SizeOption = None,
     deinterlace: DeinterlaceOption = DEFAULTS.deinterlace,
     bars: BarsOption = DEFAULTS.bars,
+    fps: FpsOption = None,
     gyro: Path | None = typer.Option(
         None, help="Stabilise from this gyro log (synchronised to the video) instead."
     ),

@@ -78,6 +78,17 @@ def read_frame_timestamps_s(path: str | Path) -> np.ndarray:
     return _frame_times(Path(path), 1.0)
 
 
+def first_stamp(start_number: int | None) -> int:
+    """The line (0-based) of a timestamps file that dates an image sequence's first image
+    ``start_number``: line N dates image N, the first line image 0 or 1; a video (None)
+    starts at the first line.
+
+    >>> first_stamp(99), first_stamp(1), first_stamp(0), first_stamp(None)
+    (98, 0, 0, 0)
+    """
+    return max((start_number or 1) - 1, 0)
+
+
 def sensor_frame_times(path: str | Path, first: int, count: int) -> np.ndarray:
     """``count`` frame times (s, on the sensor's clock) from line ``first`` (0-based) of a
     timestamps file: seconds per line (phone-cc9), or integer nanoseconds (OpenCamera)."""

@@ -193,6 +193,17 @@ def test_a_deep_source_stays_10_bit(shaky, tmp_path, name, encode):
     assert any(n.startswith("10-bit video: encoded with libx265") for n in summary["notices"])
 
 
+def test_an_image_sequence_is_read_from_its_lowest_number_at_the_rate_given(shaky, tmp_path):
+    # numbered from 99, as phone-cc9's frames are (FFmpeg alone tries only 0–4)
+    pattern = tmp_path / "RE_frame-%d.jpg"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-frames:v", "20", "-q:v", "2"]
+    subprocess.run([*cmd, "-start_number", "99", str(pattern)], check=True)
+    out = tmp_path / "out.mp4"
+    summary, _ = stabilize_video(pattern, out, Settings(fov=70.0, fps=24.0))
+    assert summary["frames"] == 20 and probe(out).fps == 24.0
+    assert np.allclose(np.diff(frame_times(out)), 1 / 24, atol=1e-3)
+
+
 def test_a_deep_source_keeps_the_encoder_asked_for(shaky, tmp_path):
     ten = tmp_path / "ten.mp4"
     cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-t", "1", "-c:v", "libx264"]

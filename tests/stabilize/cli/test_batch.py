@@ -20,7 +20,8 @@ def test_batch_takes_every_option_of_the_single_file_command():
     names = {name: {p.name for p in commands[name].params} for name in ("run", "batch")}
     per_file = {"input_path", "output_path", "report", "overwrite", "as_json"}
     per_clip_gyro = {"gyro_offset", "gyro_axes", "gyro_timestamps"}  # each clip has its own
-    assert names["run"] - per_file - per_clip_gyro <= names["batch"]
+    per_sequence = {"fps"}  # an image sequence's rate: batch takes a folder's videos
+    assert names["run"] - per_file - per_clip_gyro - per_sequence <= names["batch"]
 
 
 def test_batch_passes_the_options_on(tmp_path):

@@ -47,6 +47,7 @@ CASES = {
     "truncated video": Case((), 2, early=False, source="truncated"),
     "one frame": Case((), 2, early=False, source="one frame"),
     "audio only": Case((), 2, source="audio only"),
+    "image sequence matching nothing": Case((), 2, source="no frames"),
     # bad outputs
     "output is the input": Case((), 2, out="{input}"),
     "output exists": Case((), 2, out="exists.mp4", files={"exists.mp4": "keep me"}),
@@ -68,6 +69,7 @@ CASES = {
     "fov 200": Case(("--fov", "200"), 2),
     "focal negative": Case(("--focal", "-5"), 2),
     "smooth zero": Case(("--smooth", "0"), 2),
+    "fps zero": Case(("--fps", "0"), 2, source="frames"),
     "max zoom below 1": Case(("--max-zoom", "0.5"), 2),
     "crf 99": Case(("--crf", "99"), 2),
     "unknown codec": Case(("--codec", "nope"), 2),
@@ -116,6 +118,8 @@ CASES = {
     "ProRes MOV input": Case((), 0, early=False, source="prores.mov", container="mp4"),
     "AV1 input": Case((), 0, early=False, source="av1.mkv", container="mp4"),
     "interlaced MPEG-2 TS input": Case((), 0, early=False, source="50i.ts", container="mp4"),
+    # numbered from 7, as a sequence cut from a longer one is: FFmpeg alone tries 0–4
+    "image sequence from 7": Case((), 0, early=False, source="frames", container="mp4"),
 }
 if shutil.which("nvidia-smi"):  # pragma: no cover - a machine with a GPU runs it
     CASES.pop("cuda without a GPU")
@@ -147,6 +151,12 @@ def make_input(name: str, shaky: Path, folder: Path) -> Path:
         return folder / "nope.mp4"
     if name == "folder":
         return folder
+    if name in ("frames", "no frames"):
+        pattern = folder / "img-%04d.png"
+        cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-frames:v", "12"]
+        if name == "frames":
+            subprocess.run([*cmd, "-start_number", "7", str(pattern)], check=True)
+        return pattern
     path = folder / {"odd": "odd.mp4", "one frame": "one.mp4"}.get(name, name)
     if name == "text":
         path = folder / "notes.mp4"
