@@ -19,7 +19,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from functools import partial
 from pathlib import Path
 from threading import Thread
@@ -44,13 +44,14 @@ from stabilize.path.zoom import CROP_MODES
 from stabilize.progress import ProgressFactory, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoInfo, atomic_output, frame_interval, frame_times, probe
+from stabilize.video.atomic import check_absent
 from stabilize.video.bars import BARS_MODES, detect_bars
 from stabilize.video.colour import DOLBY_BASE
 from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Encoding, Mux
 from stabilize.video.fields import DEINTERLACE_MODES
 from stabilize.video.preflight import check_encoder, check_writable, describe
-from stabilize.video.probe import first_image, sequence_args
+from stabilize.video.sequence import first_image, sequence_args
 from stabilize.video.streams import keep_streams
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.lens import Lens, read_lens_profile
@@ -183,6 +184,11 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
         info = info.within_bars(detect_bars(info))
     mux = keep_streams(info, container, info.video_delay)
     notices = mux.notices + fields_notice(info) + pixels_notice(info) + bars_notice(info)
+    if not container.timed:  # an image sequence: numbered as the input's, else from 1
+        first = first_image(info.input_args)
+        mux = replace(mux, args=(*mux.args, "-start_number", str(1 if first is None else first)))
+        if first is None:
+            notices += ("an image sequence keeps no frame times (--report's path.csv has them)",)
     notices += encoder_notice(encoding, settings.encoding.codec_for(container))
     notices += dolby_vision_notice(info.colour.dolby_vision)
     if info.colour.hdr10_lost(encoding.codec):
@@ -447,8 +453,7 @@ def _check_output(src: Path, dst: Path, overwrite: bool) -> None:
     )
     if same:
         raise ValueError(f"the output {dst} is the input; choose another name")
-    if dst.exists() and not overwrite:
-        raise FileExistsError(f"{dst} exists (use --overwrite to replace it)")
+    check_absent(dst, overwrite)
 
 
 def _camera_matrix(focal: float, info: VideoInfo, lens: Lens | None) -> NDArray:

@@ -179,7 +179,7 @@ def _video_and_times(
     times = frame_times(video, args)
     if timestamps is not None:
         from stabilize.gyro.readers import first_stamp, sensor_frame_times
-        from stabilize.video.probe import first_image
+        from stabilize.video.sequence import first_image
 
         first = first_stamp(first_image(info.input_args))
         times = sensor_frame_times(timestamps, first, len(times))

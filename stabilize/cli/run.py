@@ -59,6 +59,7 @@ from stabilize.settings import DEFAULTS
         "  stabilize shaky.mp4 steady.mp4 --smooth 1.0 --max-zoom 1.3 --report report/\n\n"
         "  stabilize drone.mp4 locked.mp4 --lock --crop dynamic\n\n"
         "  stabilize 'frames/img-%05d.jpg' steady.mp4 --fps 30\n\n"
+        "  stabilize shaky.mp4 'steady/%05d.png'     # a picture per frame\n\n"
         "  stabilize gopro.mp4 out.mp4 --lens 'GoPro_HERO7 Black_Wide_16by9.json'\n\n"
         "  stabilize in.mp4 out.mp4 --flow raft --raft-weights raft-small.pth --device cuda"
     ),
@@ -68,7 +69,9 @@ def run(
     input_path: Path = typer.Argument(
         ..., metavar="IN", help="The shaky video, or an image sequence (frames/img-%d.jpg)."
     ),
-    output_path: Path = typer.Argument(..., metavar="OUT", help="Where to write the result."),
+    output_path: Path = typer.Argument(
+        ..., metavar="OUT", help="Where to write the result: a video, or pictures (f/%05d.png)."
+    ),
     flow_name: FlowOption = DEFAULTS.flow,
     raft_weights: RaftWeightsOption = None,
     device: DeviceOption = DEFAULTS.device,

@@ -41,7 +41,7 @@ from stabilize.motion.track import VisualTrack
 from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoInfo
-from stabilize.video.probe import first_image
+from stabilize.video.sequence import first_image
 from stabilize.warp.lens import Lens
 
 FULL_FRAME_DIAGONAL_MM = 43.27

@@ -8,8 +8,9 @@ from stabilize.video.atomic import atomic_output
 from stabilize.video.binary import ffmpeg_exe
 from stabilize.video.decode import frame_interval, frame_times, read_frames
 from stabilize.video.encode import Encoding, FrameWriter
-from stabilize.video.probe import VideoError, VideoInfo, probe, sequence_args
+from stabilize.video.probe import VideoError, VideoInfo, probe
 from stabilize.video.retime import is_variable_rate, retime
+from stabilize.video.sequence import sequence_args
 
 __all__ = [
     "Encoding",

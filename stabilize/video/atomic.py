@@ -1,13 +1,32 @@
-"""Writing outputs atomically: a temporary file beside the target, renamed at the end."""
+"""Writing outputs atomically: a temporary file beside the target, renamed at the end;
+an image sequence's pictures in a temporary folder beside them, moved in at the end."""
 
 from __future__ import annotations
 
 import contextlib
 import os
 import re
+import shutil
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
+
+from stabilize.video.sequence import is_pattern, sequence_files
+
+
+def check_absent(path: str | os.PathLike, overwrite: bool) -> None:
+    """FileExistsError where ``path`` exists (an image sequence: any of its pictures)
+    and may not be replaced."""
+    final = Path(path)
+    if overwrite:
+        return
+    if is_pattern(final) and (found := sequence_files(final)):
+        raise FileExistsError(
+            f"{final}: {len(found)} pictures of this sequence exist (use --overwrite to "
+            "replace them)"
+        )
+    if final.exists():
+        raise FileExistsError(f"{final} exists (use --overwrite to replace it)")
 
 
 @contextlib.contextmanager
@@ -17,12 +36,17 @@ def atomic_output(path: str | os.PathLike, *, overwrite: bool = False) -> Iterat
     An interrupted or failed run leaves nothing under the final name. The temporary
     name keeps the suffix, so tools that pick a format from it still work, and carries
     this process's id, so that a later run can tell a killed run's leftover (swept here)
-    from a running one's (left alone).
+    from a running one's (left alone). An image sequence (``frames/%05d.png``) is
+    written into a temporary folder beside it, whose pictures replace the old
+    sequence's (every one of them, with ``overwrite``) once the block succeeds.
     """
     final = Path(path)
-    if final.exists() and not overwrite:
-        raise FileExistsError(f"{final} exists (use --overwrite to replace it)")
+    check_absent(final, overwrite)
     final.parent.mkdir(parents=True, exist_ok=True)
+    if is_pattern(final):
+        with _atomic_sequence(final) as tmp:
+            yield tmp
+        return
     sweep_stale(final.parent, f".{final.stem}.*.partial*")
     fd, tmp = tempfile.mkstemp(
         prefix=f".{final.stem}.{os.getpid()}.", suffix=f".partial{final.suffix}", dir=final.parent
@@ -39,6 +63,27 @@ def atomic_output(path: str | os.PathLike, *, overwrite: bool = False) -> Iterat
         tmp_path.unlink(missing_ok=True)
 
 
+@contextlib.contextmanager
+def _atomic_sequence(final: Path) -> Iterator[Path]:
+    # FFmpeg reads a % anywhere in the path as the frame number's place
+    stem = final.stem.replace("%", "")
+    sweep_stale(final.parent, f".{stem}.*.partial")
+    folder = Path(
+        tempfile.mkdtemp(prefix=f".{stem}.{os.getpid()}.", suffix=".partial", dir=final.parent)
+    )
+    try:
+        yield folder / final.name
+        umask = os.umask(0)
+        os.umask(umask)
+        for old in sequence_files(final).values():
+            old.unlink()
+        for picture in sorted(folder.iterdir()):
+            os.chmod(picture, 0o666 & ~umask)
+            os.replace(picture, final.parent / picture.name)
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
 _OWNER = re.compile(r"\.(\d+)\.[^.]+\.partial")  # the pid in .NAME.PID.RANDOM.partial.SUFFIX
 
 
@@ -50,7 +95,10 @@ def sweep_stale(folder: Path, pattern: str = ".*.partial*", *, recursive: bool =
     for leftover in found:
         owner = _OWNER.search(leftover.name)
         if owner is None or not _running(int(owner.group(1))):
-            leftover.unlink(missing_ok=True)
+            if leftover.is_dir():  # an image sequence's
+                shutil.rmtree(leftover, ignore_errors=True)
+            else:
+                leftover.unlink(missing_ok=True)
             swept += 1
     return swept
 

@@ -30,7 +30,7 @@ class Container:
     muxer: str
     video_encoder: str = "libx264"
     audio: frozenset[str] | None = None
-    audio_encoder: str = "aac"
+    audio_encoder: str | None = "aac"
     subtitles: frozenset[str] | None = None
     subtitle_encoder: str | None = None
     chapters: bool = True
@@ -44,9 +44,19 @@ class Container:
     # Where a start timecode goes: "track" (written again from the video's timecode tag
     # as a tmcd track, as QuickTime does), "tag" (kept as the video's tag), "" (nowhere)
     timecode: str = ""
+    # An image sequence's pictures (OUT a pattern, frames/%05d.png): their pixel formats
+    # for an 8-bit source and for a deeper one (None: the pipe's 4:2:0 at its depth)
+    pictures: tuple[str, str] | None = None
+    name: str = ""  # how notices name it (default: its muxer's name)
 
-    def audio_codec(self, codec: str) -> str:
-        """``copy`` for an audio codec held as it is, else the encoder it becomes."""
+    @property
+    def timed(self) -> bool:
+        """Whether it keeps frame times: an image sequence keeps none."""
+        return self.pictures is None
+
+    def audio_codec(self, codec: str) -> str | None:
+        """``copy`` for an audio codec held as it is, else the encoder it becomes (None:
+        it cannot be held)."""
         return "copy" if self.audio is None or codec in self.audio else self.audio_encoder
 
     def subtitle_codec(self, codec: str) -> str | None:
@@ -67,6 +77,25 @@ MP4 = Container(
     data=frozenset({"gpmd"}),  # GoPro's GPMF telemetry (its gyro): telemetry-parser reads it back
     timecode="track",
 )
+
+
+def image_sequence(encoder: str, pictures: tuple[str, str]) -> Container:
+    """An image sequence written by a picture ``encoder``: no audio, subtitles or
+    chapters (each left out with a notice), no frame times."""
+    return Container(
+        "image2",
+        encoder,
+        audio=frozenset(),
+        audio_encoder=None,
+        subtitles=frozenset(),
+        chapters=False,
+        pictures=pictures,
+        name="an image sequence",
+    )
+
+
+JPEG = image_sequence("mjpeg", ("yuvj420p", "yuvj420p"))  # full range, as JPEG files are
+TIFF = image_sequence("tiff", ("rgb24", "rgb48le"))
 
 # The registry: an output suffix → its container. Adding one is a line here.
 CONTAINERS: dict[str, Container] = {
@@ -105,6 +134,13 @@ CONTAINERS: dict[str, Container] = {
         chapters=False,
         deep_encoder="libx265",
     ),
+    # OUT a pattern (frames/%05d.png): a picture per frame, at 16 bits a channel for a
+    # source of 10 bits or more where the format holds them (PNG, TIFF)
+    ".png": image_sequence("png", ("rgb24", "rgb48be")),
+    ".jpg": JPEG,
+    ".jpeg": JPEG,
+    ".tif": TIFF,
+    ".tiff": TIFF,
 }
 
 

@@ -48,7 +48,9 @@ class Encoding:
 
         A 10-bit pipe (``yuv420p10le``) is encoded at 10 bits, by the container's encoder
         for deep sources where none is asked for: HEVC in MP4, MOV, MKV and TS, since
-        H.264 at 10 bits plays neither on Apple's devices nor in most browsers.
+        H.264 at 10 bits plays neither on Apple's devices nor in most browsers. An image
+        sequence's pictures take their format's pixels (16 bits a channel in PNG and
+        TIFF for a deep source).
 
         >>> from stabilize.video.containers import container_for
         >>> deep = Encoding().for_frames(container_for("a.mov"), "yuv420p10le")
@@ -58,8 +60,13 @@ class Encoding:
         'libx264'
         >>> Encoding(codec="libx264").for_frames(container_for("a.mov"), "yuv420p10le").codec
         'libx264'
+        >>> Encoding().for_frames(container_for("f/%05d.png"), "yuv420p10le").pix_fmt
+        'rgb48be'
         """
-        if pix_fmt_in != "yuv420p10le":
+        deep = pix_fmt_in == "yuv420p10le"
+        if container.pictures:  # an image sequence's: RGB, or JPEG's full-range YUV
+            return replace(self, codec=self.codec_for(container), pix_fmt=container.pictures[deep])
+        if not deep:
             return replace(self, codec=self.codec_for(container))
         codec = self.codec or container.deep_encoder or container.video_encoder
         pix_fmt = pix_fmt_in if self.pix_fmt == "yuv420p" else self.pix_fmt

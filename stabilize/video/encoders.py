@@ -1,7 +1,8 @@
 """Video encoders: how each takes the job's quality and speed (``--crf``, ``--preset``).
 
 x264 and x265 take both as they are. The others get their own scales: VP9 constant
-quality needs ``-b:v 0``, and its speed is ``-cpu-used``; SVT-AV1 numbers its presets.
+quality needs ``-b:v 0``, and its speed is ``-cpu-used``; SVT-AV1 numbers its presets;
+an image sequence's JPEG takes a quantiser, and its PNG or TIFF neither (lossless).
 An encoder not listed gets ``-crf`` and ``-preset`` as they are, and the pre-flight check
 (:func:`stabilize.video.preflight.check_encoder`) refuses what it does not take.
 """
@@ -17,6 +18,9 @@ X264_PRESETS = (
 )  # fmt: skip
 # The quality a user gets from the default --crf 18 of x264, per encoder's own scale.
 DEFAULT_CRF = {"libx264": 18, "libx265": 20, "libvpx-vp9": 31, "libsvtav1": 30, "libaom-av1": 30}
+# JPEG's quantiser (-q:v, 1 best to 31) per step of x264's CRF: 18 gives 2, the usual
+# choice for frames kept for analysis
+CRF_PER_JPEG_Q = 9
 
 
 def _speed(preset: str, slowest: int, fastest: int) -> int:
@@ -44,6 +48,14 @@ def _aom(crf: int, preset: str) -> list[str]:
     return ["-crf", str(crf), "-cpu-used", str(_speed(preset, 1, 8)), "-row-mt", "1"]
 
 
+def _jpeg(crf: int, preset: str) -> list[str]:
+    return ["-q:v", str(min(max(round(crf / CRF_PER_JPEG_Q), 1), 31))]
+
+
+def _lossless(crf: int, preset: str) -> list[str]:
+    return []  # PNG and TIFF keep every sample: no quality to choose
+
+
 # The registry: an encoder's name → its arguments for (crf, preset).
 ENCODERS: dict[str, Callable[[int, str], list[str]]] = {
     "libx264": _x26x,
@@ -51,6 +63,9 @@ ENCODERS: dict[str, Callable[[int, str], list[str]]] = {
     "libvpx-vp9": _vp9,
     "libsvtav1": _svtav1,
     "libaom-av1": _aom,
+    "mjpeg": _jpeg,
+    "png": _lossless,
+    "tiff": _lossless,
 }
 
 

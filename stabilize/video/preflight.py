@@ -13,6 +13,7 @@ from pathlib import Path
 from stabilize.video.binary import ffmpeg_exe
 from stabilize.video.containers import container_for
 from stabilize.video.encode import Encoding, output_args
+from stabilize.video.sequence import is_pattern
 
 
 class OutputError(ValueError):
@@ -39,15 +40,22 @@ def check_encoder(path: str | Path, encoding: Encoding, size: tuple[int, int]) -
     """That FFmpeg encodes two frames of (H, W) ``size`` with these options into the
     container ``path``'s suffix names; else FFmpeg's own first complaint, in one line."""
     h, w = size
+    container = container_for(path)
+    if container.pictures and not is_pattern(path):
+        raise OutputError(
+            f"{Path(path)} names one picture: name an image sequence with the frame's "
+            f"number in it, e.g. {Path(path).with_name(Path(path).stem + '-%05d')}"
+            f"{Path(path).suffix}"
+        )
     with tempfile.TemporaryDirectory(prefix="stabilize-check.") as tmp:
-        out = Path(tmp) / f"check{Path(path).suffix}"
+        out = Path(tmp) / f"check{'%d' if container.pictures else ''}{Path(path).suffix}"
         cmd = [ffmpeg_exe(), "-hide_banner", "-loglevel", "error", "-nostdin", "-y"]
         cmd += ["-f", "lavfi", "-i", f"color=black:s={w}x{h}:r=30", "-frames:v", "2"]
-        cmd += [*output_args(out, encoding, container_for(path)), str(out)]
+        cmd += [*output_args(out, encoding, container), str(out)]
         result = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
     if result.returncode != 0:
         first = (result.stderr.strip().splitlines() or ["exit status " + str(result.returncode)])[0]
-        codec = encoding.codec_for(container_for(path))
+        codec = encoding.codec_for(container)
         raise OutputError(
             f"FFmpeg cannot write {codec} (preset {encoding.preset}) as "
             f"{Path(path).suffix or 'this file'}: {first}"

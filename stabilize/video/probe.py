@@ -17,6 +17,7 @@ from stabilize.video.colour import UNKNOWN, Colour, colour_of, dolby_vision, wit
 from stabilize.video.fields import DEINTERLACE_MODES, field_order, frame_field_order, interlaced
 from stabilize.video.first_frame import first_frame_report
 from stabilize.video.i420 import pipe_format
+from stabilize.video.sequence import first_image, is_pattern, sequence_args
 
 
 class VideoError(ValueError):
@@ -204,57 +205,19 @@ def _from_frames(path: Path, input_args: tuple, pix_fmt: str, details: str) -> t
     return order or frame_field_order(report), with_hdr10(colour, report)
 
 
-SEQUENCE_FPS = 30.0  # an image sequence's frame rate where none is given (a phone's)
-_NUMBER = re.compile(r"%0?\d*d")  # the frame number's place in a pattern: %d, %05d
-
-
-def first_number(pattern: str | Path) -> int | None:
-    """The lowest number among the files an image-sequence pattern names (``img-%05d.jpg``:
-    ``img-00099.jpg`` → 99), or None where none exists. FFmpeg itself tries only 0–4, so
-    a sequence cut from a longer one (phone-cc9's frames start at 99) was not found.
-
-    >>> first_number("/no/such/folder/img-%d.jpg") is None
-    True
-    """
-    path = Path(pattern)
-    name = re.compile(_NUMBER.sub(r"(\\d+)", re.escape(path.name), count=1) + "$")
-    if not path.parent.is_dir():
-        return None
-    found = (name.match(p.name) for p in path.parent.iterdir())
-    return min((int(m.group(1)) for m in found if m), default=None)
-
-
-def sequence_args(
-    path: str | Path, start_number: int | None = None, fps: float | None = None
-) -> tuple:
-    """FFmpeg input options for an image sequence (a %d pattern), else none: its first
-    number (``start_number``, else the lowest its files carry) and its frame rate
-    (``fps``, else :data:`SEQUENCE_FPS`)."""
-    if "%" not in str(path):
-        return ()
-    start = first_number(path) if start_number is None else start_number
-    if start is None:
-        raise VideoError(f"{path}: no file matches this pattern")
-    return ("-f", "image2", "-start_number", str(start), "-framerate", str(fps or SEQUENCE_FPS))
-
-
-def first_image(input_args: tuple) -> int | None:
-    """The first image's number in an image sequence's input options; None for a video."""
-    args = dict(zip(input_args[::2], input_args[1::2], strict=False))
-    return int(args["-start_number"]) if "-start_number" in args else None
-
-
 def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     """What FFmpeg reports of the first video stream, or :class:`VideoError`.
 
     ``path`` may be an image-sequence pattern (``frames/img-%d.jpg``) with the input
     options of :func:`sequence_args` (by default its lowest number, at 30 fps).
     """
-    pattern = "%" in str(path)
+    pattern = is_pattern(path)
     input_args = input_args or sequence_args(path)  # a sequence's first number, at 30 fps
     path = Path(path)
     if not pattern and not path.exists():
         raise VideoError(f"{path}: no such file")
+    if pattern and first_image(input_args) is None:
+        raise VideoError(f"{path}: no file matches this pattern")
     if path.is_dir():
         raise VideoError(f"{path}: is a folder, not a video (give a pattern like dir/img-%d.jpg)")
     result = subprocess.run(

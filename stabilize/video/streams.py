@@ -112,4 +112,4 @@ def _first_video(info: VideoInfo) -> int:
 
 
 def _name(container: Container) -> str:
-    return container.muxer.upper() if container.muxer else "this container"
+    return container.name or (container.muxer.upper() if container.muxer else "this container")

@@ -52,7 +52,7 @@ def render(
     fps = info.fps or 30.0
     h, w = frame_size(info, settings)
     size = encoded_size(info, settings)
-    variable = is_variable_rate(planned.times)
+    variable = container.timed and is_variable_rate(planned.times)
     pix_fmt = piped_format(info, settings)
     planar = pix_fmt != "rgb24"
     encoding = output_encoding(info, settings, container)

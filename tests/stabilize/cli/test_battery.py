@@ -54,6 +54,8 @@ CASES = {
     "output folder is a file": Case((), 2, out="afile/out.mp4", files={"afile": "x"}),
     "output under /proc": Case((), 2, out="/proc/stabilize-test.mp4"),
     "unknown output suffix": Case((), 2, out="out.notacontainer"),
+    "one picture for a clip": Case((), 2, out="out.png"),
+    "pictures exist": Case((), 2, out="f%02d.png", files={"f07.png": "keep me"}),
     "report is a file": Case(("--report", "{dir}/notes.txt"), 2, files={"notes.txt": "x"}),
     "rotations onto an existing file": Case(("-o", "{dir}/r.csv"), 2, files={"r.csv": "x"}),
     # bad options
@@ -120,6 +122,7 @@ CASES = {
     "interlaced MPEG-2 TS input": Case((), 0, early=False, source="50i.ts", container="mp4"),
     # numbered from 7, as a sequence cut from a longer one is: FFmpeg alone tries 0–4
     "image sequence from 7": Case((), 0, early=False, source="frames", container="mp4"),
+    "image sequence output": Case((), 0, early=False, out="pictures/%04d.png", container="image2"),
 }
 if shutil.which("nvidia-smi"):  # pragma: no cover - a machine with a GPU runs it
     CASES.pop("cuda without a GPU")

@@ -38,3 +38,32 @@ def test_a_failed_block_leaves_nothing(tmp_path):
         tmp.write_bytes(b"half")
         raise RuntimeError("encoder died")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_image_sequence_is_moved_in_whole_replacing_the_old_one(tmp_path):
+    pattern = tmp_path / "frames" / "f%03d.png"
+    dead = tmp_path / "frames" / f".f03d.{dead_pid()}.abcd1234.partial"
+    dead.mkdir(parents=True)
+    (dead / "f001.png").write_bytes(b"half")
+    old = [tmp_path / "frames" / f"f{n:03d}.png" for n in (1, 2, 3)]
+    for path in old:
+        path.write_bytes(b"old")
+    with pytest.raises(FileExistsError, match="3 pictures of this sequence exist"):
+        with atomic_output(pattern):
+            pass
+    with atomic_output(pattern, overwrite=True) as tmp:
+        assert "%" not in str(tmp.parent)  # FFmpeg reads any % as the number's place
+        for n in (1, 2):
+            (tmp.parent / tmp.name.replace("%03d", f"{n:03d}")).write_bytes(b"new")
+    names = sorted(p.name for p in (tmp_path / "frames").iterdir())
+    assert names == ["f001.png", "f002.png"]  # the old third, and the dead run's folder, gone
+    assert old[0].read_bytes() == b"new"
+
+
+def test_a_failed_image_sequence_leaves_the_old_one(tmp_path):
+    old = tmp_path / "f1.png"
+    old.write_bytes(b"old")
+    with pytest.raises(RuntimeError), atomic_output(tmp_path / "f%d.png", overwrite=True) as tmp:
+        (tmp.parent / "f1.png").write_bytes(b"half")
+        raise RuntimeError("encoder died")
+    assert [p.name for p in tmp_path.iterdir()] == ["f1.png"] and old.read_bytes() == b"old"

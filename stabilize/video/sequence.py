@@ -1,0 +1,67 @@
+"""Image sequences: a clip stored as one picture per frame, named by a pattern whose
+``%d`` (or ``%05d``) is the frame's number, as a dataset's frames are (phone-cc9's
+``RE_frame-%d.jpg``).
+
+As an input it is read from the lowest number its files carry, at a frame rate given
+(:func:`sequence_args`). As an output (``frames/%05d.png``) it is written into a hidden
+folder beside the target and moved into place once every frame is written
+(:func:`stabilize.video.atomic.atomic_output`).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+SEQUENCE_FPS = 30.0  # an image sequence's frame rate where none is given (a phone's)
+_NUMBER = re.compile(r"%0?\d*d")  # the frame number's place in a pattern: %d, %05d
+
+
+def is_pattern(path: str | Path) -> bool:
+    """Whether ``path`` names an image sequence: its file name holds a frame number.
+
+    >>> is_pattern("frames/img-%05d.jpg"), is_pattern("out/%d.png"), is_pattern("a%20b.mp4")
+    (True, True, False)
+    """
+    return bool(_NUMBER.search(Path(path).name))
+
+
+def sequence_files(pattern: str | Path) -> dict[int, Path]:
+    """The files an image-sequence pattern names that exist, by their number.
+
+    >>> sequence_files("/no/such/folder/img-%d.jpg")
+    {}
+    """
+    path = Path(pattern)
+    name = re.compile(_NUMBER.sub(r"(\\d+)", re.escape(path.name), count=1) + "$")
+    if not path.parent.is_dir():
+        return {}
+    found = ((name.match(p.name), p) for p in path.parent.iterdir())
+    return {int(m.group(1)): p for m, p in found if m}
+
+
+def first_number(pattern: str | Path) -> int | None:
+    """The lowest number among the files an image-sequence pattern names (``img-%05d.jpg``:
+    ``img-00099.jpg`` → 99), or None where none exists. FFmpeg itself tries only 0–4, so
+    a sequence cut from a longer one (phone-cc9's frames start at 99) was not found."""
+    return min(sequence_files(pattern), default=None)
+
+
+def sequence_args(
+    path: str | Path, start_number: int | None = None, fps: float | None = None
+) -> tuple:
+    """FFmpeg input options for an image sequence, else none: its first number
+    (``start_number``, else the lowest its files carry; left out where none exists) and
+    its frame rate (``fps``, else :data:`SEQUENCE_FPS`)."""
+    if not is_pattern(path):
+        return ()
+    start = first_number(path) if start_number is None else start_number
+    first = () if start is None else ("-start_number", str(start))
+    return ("-f", "image2", *first, "-framerate", str(fps or SEQUENCE_FPS))
+
+
+def first_image(input_args: tuple) -> int | None:
+    """The first image's number in an image sequence's input options; None for a video
+    (or a pattern that names no file)."""
+    args = dict(zip(input_args[::2], input_args[1::2], strict=False))
+    return int(args["-start_number"]) if "-start_number" in args else None

@@ -1,0 +1,62 @@
+"""Image sequences: read from their lowest number, written as pictures numbered as the
+input's (else from 1), at 16 bits a channel for a deep source where the format holds it."""
+
+from __future__ import annotations
+
+import subprocess
+
+import numpy as np
+import pytest
+
+from stabilize import Settings, stabilize_video
+from stabilize.video import ffmpeg_exe, probe, read_frames
+from stabilize.video.sequence import first_number, sequence_args, sequence_files
+
+
+def test_a_sequence_is_found_from_its_lowest_number(tmp_path):
+    for n in (99, 100, 250):
+        (tmp_path / f"img-{n:05d}.jpg").write_bytes(b"")
+    (tmp_path / "img-00007.png").write_bytes(b"")  # another suffix: not of it
+    pattern = tmp_path / "img-%05d.jpg"
+    assert sorted(sequence_files(pattern)) == [99, 100, 250] and first_number(pattern) == 99
+    assert sequence_args(pattern, fps=24) == (
+        "-f", "image2", "-start_number", "99", "-framerate", "24",
+    )  # fmt: skip
+    assert sequence_args(tmp_path / "clip.mp4") == ()
+
+
+def test_a_video_becomes_pictures_numbered_from_1(shaky, tmp_path):
+    pattern = tmp_path / "frames" / "f%04d.png"
+    summary, _ = stabilize_video(shaky, pattern, Settings(fov=70.0))
+    assert sorted(sequence_files(pattern)) == list(range(1, 61)) and summary["frames"] == 60
+    assert any("left out audio" in n for n in summary["notices"])
+    assert any("keeps no frame times" in n for n in summary["notices"])
+    assert not [p for p in pattern.parent.iterdir() if p.name.startswith(".")]
+    video = list(read_frames(shaky))
+    pictures = list(read_frames(pattern))
+    assert len(pictures) == 60 and pictures[0].shape == video[0].shape
+    # stabilised, not black: the pictures' tones are the clip's
+    assert abs(np.mean(pictures[30]) - np.mean(video[30])) < 8
+
+
+def test_pictures_keep_the_input_sequences_numbers_and_a_deep_sources_depth(shaky, tmp_path):
+    source = tmp_path / "in" / "RE_frame-%d.png"
+    source.parent.mkdir()
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-frames:v", "20"]
+    cmd += ["-pix_fmt", "rgb48be", "-start_number", "99", str(source)]
+    subprocess.run(cmd, check=True)
+    out = tmp_path / "out" / "RE_frame-%d.png"
+    summary, _ = stabilize_video(source, out, Settings(fov=70.0))
+    assert sorted(sequence_files(out)) == list(range(99, 119))
+    assert probe(out).pix_fmt == "rgb48be"  # 10 bits kept, in 16-bit PNG
+    assert not any("frame times" in n for n in summary["notices"])  # none to keep
+
+
+@pytest.mark.parametrize(("name", "codec"), [("%03d.jpg", "mjpeg"), ("%03d.tif", "tiff")])
+def test_jpeg_and_tiff_pictures(shaky, tmp_path, name, codec):
+    clip = tmp_path / "short.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-t", "0.5", "-c:v", "libx264"]
+    subprocess.run([*cmd, str(clip)], check=True)
+    summary, _ = stabilize_video(clip, tmp_path / name, Settings(fov=70.0))
+    assert len(sequence_files(tmp_path / name)) == summary["frames"] == 15
+    assert probe(tmp_path / name).codec == codec
