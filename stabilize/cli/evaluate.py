@@ -10,7 +10,7 @@ import typer
 
 from stabilize.cli.app import app, fail
 from stabilize.cli.bars import progress_bar
-from stabilize.cli.options import QuietOption
+from stabilize.cli.options import FpsOption, QuietOption
 
 
 @app.command(
@@ -34,7 +34,9 @@ from stabilize.cli.options import QuietOption
     )
 )
 def evaluate(
-    original: Path = typer.Argument(..., help="The input clip."),
+    original: Path = typer.Argument(
+        ..., help="The input clip (or image sequence: frames/img-%d.jpg)."
+    ),
     stabilised: Path = typer.Argument(..., help="Its stabilised version (from any tool)."),
     truth: Path | None = typer.Option(None, help="truth.csv of a rendered clip."),
     rotations: Path | None = typer.Option(
@@ -44,13 +46,14 @@ def evaluate(
     plot: Path | None = typer.Option(
         None, help="Also draw the shake's parts of both clips over time, and the distortion (PNG)."
     ),
+    fps: FpsOption = None,
     quiet: QuietOption = False,
 ) -> None:
     """Cropping ratio, distortion, stability, ITF, residual shake and wobble of a
     stabilised clip and its original."""
     from stabilize.evaluate.metrics import evaluate_pair
     from stabilize.motion.files import angular_errors, read_rotations
-    from stabilize.video import VideoError, probe, read_frames
+    from stabilize.video import VideoError, probe, read_frames, sequence_args
 
     if (truth is None) != (rotations is None):
         fail("--truth and --rotations go together")
@@ -59,7 +62,8 @@ def evaluate(
     if plot is not None and not plot.parent.is_dir():
         fail(f"--plot {plot}: no such folder {plot.parent}")
     try:
-        info_o, info_s = probe(original), probe(stabilised)
+        info_o = probe(original, sequence_args(original, fps=fps))
+        info_s = probe(stabilised, sequence_args(stabilised, fps=fps))
         size, fps = info_o.size, info_o.fps or 30.0
         with progress_bar("evaluating", None, quiet=quiet) as advance:
             before, after = evaluate_pair(

@@ -18,6 +18,8 @@ X264_PRESETS = (
 )  # fmt: skip
 # The quality a user gets from the default --crf 18 of x264, per encoder's own scale.
 DEFAULT_CRF = {"libx264": 18, "libx265": 20, "libvpx-vp9": 31, "libsvtav1": 30, "libaom-av1": 30}
+# The encoders whose frames lean on one another: no picture file holds one alone
+VIDEO_ONLY = frozenset({"libx264", "libx265", "libvpx-vp9", "libsvtav1", "libaom-av1"})
 # JPEG's quantiser (-q:v, 1 best to 31) per step of x264's CRF: 18 gives 2, the usual
 # choice for frames kept for analysis
 CRF_PER_JPEG_Q = 9

@@ -13,6 +13,7 @@ from pathlib import Path
 from stabilize.video.binary import ffmpeg_exe
 from stabilize.video.containers import container_for
 from stabilize.video.encode import Encoding, output_args
+from stabilize.video.encoders import VIDEO_ONLY
 from stabilize.video.sequence import is_pattern
 
 
@@ -46,6 +47,11 @@ def check_encoder(path: str | Path, encoding: Encoding, size: tuple[int, int]) -
             f"{Path(path)} names one picture: name an image sequence with the frame's "
             f"number in it, e.g. {Path(path).with_name(Path(path).stem + '-%05d')}"
             f"{Path(path).suffix}"
+        )
+    if container.pictures and encoding.codec in VIDEO_ONLY:
+        raise OutputError(
+            f"--codec {encoding.codec} writes video, not pictures: leave it out for "
+            f"{Path(path).suffix} pictures"
         )
     with tempfile.TemporaryDirectory(prefix="stabilize-check.") as tmp:
         out = Path(tmp) / f"check{'%d' if container.pictures else ''}{Path(path).suffix}"

@@ -56,6 +56,7 @@ CASES = {
     "unknown output suffix": Case((), 2, out="out.notacontainer"),
     "one picture for a clip": Case((), 2, out="out.png"),
     "pictures exist": Case((), 2, out="f%02d.png", files={"f07.png": "keep me"}),
+    "video encoder for pictures": Case(("--codec", "libx264"), 2, out="f%02d.png"),
     "report is a file": Case(("--report", "{dir}/notes.txt"), 2, files={"notes.txt": "x"}),
     "rotations onto an existing file": Case(("-o", "{dir}/r.csv"), 2, files={"r.csv": "x"}),
     # bad options

@@ -38,3 +38,20 @@ def test_evaluate_draws_the_shake(tmp_path):
     for wrong, why in wrongs.items():
         bad = CliRunner().invoke(app, ["evaluate", sample, sample, "--plot", str(tmp_path / wrong)])
         assert bad.exit_code == 2 and why in bad.output
+
+
+def test_evaluate_reads_an_image_sequence_at_the_rate_given(tmp_path):
+    import subprocess
+
+    from stabilize.video import ffmpeg_exe
+
+    frames = tmp_path / "f%03d.png"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", "samples/street/clip.mp4", "-frames:v", "24"]
+    subprocess.run([*cmd, "-start_number", "50", str(frames)], check=True)
+    shake = {}
+    for fps in ("10", "60"):  # the high-pass keeps 0.5 s: 5 frames, or 30
+        args = ["evaluate", str(frames), str(frames), "--fps", fps, "--json", "-q"]
+        result = CliRunner().invoke(app, args)
+        assert result.exit_code == 0, result.output
+        shake[fps] = json.loads(result.stdout)["original"]["residual_shake_px"]
+    assert shake["10"] < shake["60"]
