@@ -17,7 +17,7 @@ from stabilize.video.colour import UNKNOWN, Colour, colour_of, dolby_vision, wit
 from stabilize.video.fields import DEINTERLACE_MODES, field_order, frame_field_order, interlaced
 from stabilize.video.first_frame import first_frame_report
 from stabilize.video.i420 import pipe_format
-from stabilize.video.sequence import first_image, is_pattern, sequence_args
+from stabilize.video.sequence import first_image, gap_message, is_pattern, sequence_args
 
 
 class VideoError(ValueError):
@@ -216,8 +216,10 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     path = Path(path)
     if not pattern and not path.exists():
         raise VideoError(f"{path}: no such file")
-    if pattern and first_image(input_args) is None:
+    if pattern and (first := first_image(input_args)) is None:
         raise VideoError(f"{path}: no file matches this pattern")
+    if pattern and (gap := gap_message(path, first)):
+        raise VideoError(gap)
     if path.is_dir():
         raise VideoError(f"{path}: is a folder, not a video (give a pattern like dir/img-%d.jpg)")
     result = subprocess.run(

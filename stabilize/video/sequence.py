@@ -11,6 +11,7 @@ folder beside the target and moved into place once every frame is written
 from __future__ import annotations
 
 import re
+from itertools import pairwise
 from pathlib import Path
 
 SEQUENCE_FPS = 30.0  # an image sequence's frame rate where none is given (a phone's)
@@ -45,6 +46,28 @@ def first_number(pattern: str | Path) -> int | None:
     ``img-00099.jpg`` → 99), or None where none exists. FFmpeg itself tries only 0–4, so
     a sequence cut from a longer one (phone-cc9's frames start at 99) was not found."""
     return min(sequence_files(pattern), default=None)
+
+
+def gap_message(pattern: str | Path, start: int) -> str | None:
+    """What is missing where an image sequence has a gap after image ``start``, or None
+    where its images run on without one. FFmpeg reads a sequence only up to its first
+    gap, so every image after it would be lost without a word.
+
+    >>> gap_message("/no/such/folder/img-%d.jpg", 1) is None
+    True
+    """
+    numbers = sorted(n for n in sequence_files(pattern) if n >= start)
+    gaps = [(a, b) for a, b in pairwise(numbers) if b > a + 1]
+    if not gaps:
+        return None
+    (before, after), lost = gaps[0], len([n for n in numbers if n > gaps[0][0]])
+    one = after == before + 2
+    missing = f"image {before + 1} is" if one else f"images {before + 1}–{after - 1} are"
+    return (
+        f"{pattern}: {missing} missing ({start}–{before} exist, then {after} on): FFmpeg reads "
+        f"a sequence only up to its first gap, so the {lost} images after it would be lost; "
+        "fill the gap or renumber the images"
+    )
 
 
 def sequence_args(

@@ -48,6 +48,7 @@ CASES = {
     "one frame": Case((), 2, early=False, source="one frame"),
     "audio only": Case((), 2, source="audio only"),
     "image sequence matching nothing": Case((), 2, source="no frames"),
+    "image sequence with a gap": Case((), 2, source="gap"),
     # bad outputs
     "output is the input": Case((), 2, out="{input}"),
     "output exists": Case((), 2, out="exists.mp4", files={"exists.mp4": "keep me"}),
@@ -155,11 +156,13 @@ def make_input(name: str, shaky: Path, folder: Path) -> Path:
         return folder / "nope.mp4"
     if name == "folder":
         return folder
-    if name in ("frames", "no frames"):
+    if name in ("frames", "no frames", "gap"):
         pattern = folder / "img-%04d.png"
         cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-frames:v", "12"]
-        if name == "frames":
+        if name != "no frames":
             subprocess.run([*cmd, "-start_number", "7", str(pattern)], check=True)
+        if name == "gap":
+            (folder / "img-0010.png").unlink()
         return pattern
     path = folder / {"odd": "odd.mp4", "one frame": "one.mp4"}.get(name, name)
     if name == "text":

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from stabilize import Settings, stabilize_video
-from stabilize.video import ffmpeg_exe, probe, read_frames
+from stabilize.video import VideoError, ffmpeg_exe, probe, read_frames
 from stabilize.video.sequence import first_number, sequence_args, sequence_files
 
 
@@ -60,3 +60,15 @@ def test_jpeg_and_tiff_pictures(shaky, tmp_path, name, codec):
     summary, _ = stabilize_video(clip, tmp_path / name, Settings(fov=70.0))
     assert len(sequence_files(tmp_path / name)) == summary["frames"] == 15
     assert probe(tmp_path / name).codec == codec
+
+
+def test_a_gap_in_a_sequence_is_refused_where_ffmpeg_would_stop_at_it(shaky, tmp_path):
+    pattern = tmp_path / "f%03d.png"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-frames:v", "12", str(pattern)]
+    subprocess.run(cmd, check=True)
+    assert probe(pattern).width > 0  # 1–12, no gap
+    (tmp_path / "f005.png").unlink()
+    with pytest.raises(VideoError, match=r"image 5 is missing \(1–4 exist, then 6 on\).* 7 images"):
+        probe(pattern)
+    # read from after the gap (compare's --start-number), the rest runs on
+    assert probe(pattern, sequence_args(pattern, start_number=6)).width > 0
