@@ -16,6 +16,14 @@ from stabilize.video.binary import ffmpeg_exe, widen_pipe
 from stabilize.video.fields import deinterlace_filter, interlaced
 from stabilize.video.i420 import pipe_layout
 from stabilize.video.probe import VideoError, VideoInfo, probe
+from stabilize.video.sequence import is_pattern
+
+# FFmpeg's filters that turn a frame counter-clockwise by a display rotation (degrees)
+TURN_FILTERS = {
+    90: (("transpose", "cclock"),),
+    180: (("hflip", None), ("vflip", None)),
+    270: (("transpose", "clock"),),
+}
 
 
 def read_frames(
@@ -38,7 +46,10 @@ def read_frames(
     h, w = size or info.size
     args = info.input_args
     options = {k.lstrip("-"): v for k, v in zip(args[::2], args[1::2], strict=True)}
-    if not info.autorotate:
+    # An image sequence's EXIF orientation is turned here, the same on every FFmpeg: some
+    # versions turn it (9.0 does, frame by frame), others leave it
+    exif_turn = info.autorotate and info.rotation and is_pattern(path)
+    if not info.autorotate or exif_turn:
         options["noautorotate"] = None
     dh, dw = info.decoded_size
     shrink = (h, w) != (dh, dw) and h <= dh and w <= dw
@@ -48,6 +59,9 @@ def read_frames(
         # anamorphic stream's pixels are narrowed, DV's 720 to 640: that is the output.)
         options["skip_loop_filter"] = "all"
     stream = ffmpeg.input(str(path), **options)
+    if exif_turn:
+        for name, value in TURN_FILTERS[info.rotation]:
+            stream = stream.filter(name, value) if value else stream.filter(name)
     if info.deinterlace:  # before any scaling, which would blend the fields
         name, fields = deinterlace_filter(every_frame=not interlaced(info.field_order))
         stream = stream.filter(name, **fields)

@@ -17,7 +17,13 @@ from stabilize.video.colour import UNKNOWN, Colour, colour_of, dolby_vision, wit
 from stabilize.video.fields import DEINTERLACE_MODES, field_order, frame_field_order, interlaced
 from stabilize.video.first_frame import first_frame_report
 from stabilize.video.i420 import pipe_format
-from stabilize.video.sequence import first_image, gap_message, is_pattern, sequence_args
+from stabilize.video.sequence import (
+    exif_rotation,
+    first_image,
+    gap_message,
+    is_pattern,
+    sequence_args,
+)
 
 
 class VideoError(ValueError):
@@ -242,6 +248,8 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     )
     rot = _ROTATION.search(text)
     rotation = int(round(float(rot.group(1) or rot.group(2)))) % 360 if rot else 0
+    if pattern and not rot:  # an image's EXIF orientation, which FFmpeg does not list
+        rotation = exif_rotation(path, first_image(input_args))
     sar = _SAR.search(stream_line)
     aspect = Fraction(int(sar.group(1)), int(sar.group(2))) if sar and int(sar.group(2)) else 0
     aspect = aspect or Fraction(1)  # none, or 0:1 ("unknown"): square

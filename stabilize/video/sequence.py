@@ -48,6 +48,25 @@ def first_number(pattern: str | Path) -> int | None:
     return min(sequence_files(pattern), default=None)
 
 
+# EXIF's Orientation (tag 274) → the display rotation, degrees counter-clockwise, as
+# FFmpeg gives a video's: 6, "turn 90° clockwise to show", is a phone held upright.
+# The mirrored orientations (2, 4, 5, 7) come from no camera and are left as stored.
+EXIF_ROTATION = {1: 0, 3: 180, 6: 270, 8: 90}
+
+
+def exif_rotation(pattern: str | Path, number: int) -> int:
+    """The display rotation that image ``number``'s EXIF Orientation asks for, which
+    FFmpeg's listing of an image sequence does not give: a phone's photos held upright
+    are stored sideways, with orientation 6. 0 where it says none."""
+    try:
+        from PIL import Image
+
+        with Image.open(str(pattern) % number) as image:
+            return EXIF_ROTATION.get(int(image.getexif().get(0x0112, 1)), 0)
+    except (OSError, ValueError, ImportError):
+        return 0
+
+
 def gap_message(pattern: str | Path, start: int) -> str | None:
     """What is missing where an image sequence has a gap after image ``start``, or None
     where its images run on without one. FFmpeg reads a sequence only up to its first
