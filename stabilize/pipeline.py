@@ -46,6 +46,7 @@ from stabilize.settings import Settings
 from stabilize.video import VideoInfo, atomic_output, frame_interval, frame_times, probe
 from stabilize.video.atomic import check_absent
 from stabilize.video.bars import BARS_MODES, detect_bars
+from stabilize.video.binary import local
 from stabilize.video.colour import DOLBY_BASE
 from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Encoding, Mux
@@ -386,7 +387,8 @@ def _write(
         try:
             return render(src, tmp, job.info, planned, settings, progress, job.mux)
         except EncodeError as err:
-            raise EncodeError(str(err).replace(str(tmp), str(dst))) from None
+            named = str(err).replace(local(tmp), str(dst)).replace(str(tmp), str(dst))
+            raise EncodeError(named) from None
         except OSError as err:
             raise EncodeError(f"cannot write {dst}: {describe(err)}") from None
 

@@ -7,6 +7,7 @@ wheel, so a fresh machine needs no system package.
 from __future__ import annotations
 
 import functools
+import os
 import shutil
 import subprocess
 from collections.abc import Sequence
@@ -21,6 +22,17 @@ def ffmpeg_exe() -> str:
     import imageio_ffmpeg
 
     return imageio_ffmpeg.get_ffmpeg_exe()
+
+
+def local(path: str | Path) -> str:
+    """``path`` as FFmpeg reads a local file whatever its name: absolute, so that a
+    colon in a relative name (``take:2.mp4``, an ISO time ``10:11:12.mp4``) is not
+    taken for a protocol's, which made such a clip "not a video FFmpeg can read".
+
+    >>> local("/clips/take:2.mp4")
+    '/clips/take:2.mp4'
+    """
+    return os.path.abspath(path)
 
 
 PIPE_BYTES = 1 << 20  # Linux's default ceiling for an unprivileged pipe
@@ -43,6 +55,6 @@ def filter_log(
     """What FFmpeg's video filters ``chain`` log (its stderr) over the first video
     stream of ``path``, decoded and thrown away: ``before`` are input options (which
     frames to decode), ``after`` output ones (how many to pass)."""
-    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *before, "-i", str(path)]
+    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *before, "-i", local(path)]
     cmd += ["-map", "0:v:0", "-vf", chain, *after, "-f", "null", "-"]
     return subprocess.run(cmd, capture_output=True, text=True, errors="replace").stderr

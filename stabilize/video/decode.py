@@ -12,7 +12,7 @@ import ffmpeg
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.video.binary import ffmpeg_exe, widen_pipe
+from stabilize.video.binary import ffmpeg_exe, local, widen_pipe
 from stabilize.video.fields import deinterlace_filter, interlaced
 from stabilize.video.i420 import pipe_layout
 from stabilize.video.probe import VideoError, VideoInfo, probe
@@ -58,7 +58,7 @@ def read_frames(
         # away anyway; skipping it makes the decode about 20% faster. (Not where only an
         # anamorphic stream's pixels are narrowed, DV's 720 to 640: that is the output.)
         options["skip_loop_filter"] = "all"
-    stream = ffmpeg.input(str(path), **options)
+    stream = ffmpeg.input(local(path), **options)
     if exif_turn:
         for name, value in TURN_FILTERS[info.rotation]:
             stream = stream.filter(name, value) if value else stream.filter(name)
@@ -139,7 +139,7 @@ def _framecrc_times(path: str | Path, input_args: tuple, *, decode: bool) -> np.
     """Sorted frame times from FFmpeg's framecrc of the first video stream: its packets
     (``decode`` False) or its decoded frames; None where some carry no timestamp."""
     codec = ["-c:v", "wrapped_avframe"] if decode else ["-c", "copy"]
-    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i", str(path)]
+    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i", local(path)]
     cmd += ["-map", "0:v:0", *codec, "-f", "framecrc", "-"]
     result = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
     tb = re.search(r"#tb 0: (\d+)/(\d+)", result.stdout)

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.video.binary import ffmpeg_exe, widen_pipe
+from stabilize.video.binary import ffmpeg_exe, local, widen_pipe
 from stabilize.video.colour import UNKNOWN, Colour
 from stabilize.video.containers import Container, container_for
 from stabilize.video.encoders import encoder_args
@@ -149,7 +149,7 @@ class FrameWriter:
         cmd += ["-map", "0:v", *mux.args, *_delayed(mux.video_delay)]
         codec = encoding.codec_for(container or container_for(path))
         cmd += [*output_args(path, encoding, container), *colour.ffmpeg_args()]
-        cmd += [*colour.hdr10_args(codec), str(path)]
+        cmd += [*colour.hdr10_args(codec), local(path)]
         self._process = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
         widen_pipe(self._process.stdin)
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 from fractions import Fraction
 from pathlib import Path
 
-from stabilize.video.binary import ffmpeg_exe
+from stabilize.video.binary import ffmpeg_exe, local
 from stabilize.video.colour import UNKNOWN, Colour, colour_of, dolby_vision, with_hdr10
 from stabilize.video.fields import DEINTERLACE_MODES, field_order, frame_field_order, interlaced
 from stabilize.video.first_frame import first_frame_report
@@ -229,7 +229,7 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     if path.is_dir():
         raise VideoError(f"{path}: is a folder, not a video (give a pattern like dir/img-%d.jpg)")
     result = subprocess.run(
-        [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i", str(path)],
+        [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i", local(path)],
         capture_output=True,
         text=True,
         errors="replace",

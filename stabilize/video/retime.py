@@ -9,6 +9,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from stabilize.video.binary import local
+
 TIMESCALE = 90_000  # ticks per second of retimed video (MPEG's clock)
 
 
@@ -49,7 +51,7 @@ def retime(
     ticks = np.maximum.accumulate(ticks - step) + step  # strictly rising, as a muxer needs
     last = np.median(np.diff(ticks)) if len(ticks) > 1 else TIMESCALE // 30
     gaps = np.diff(ticks, append=ticks[-1] + last)
-    with av.open(str(src)) as inp, av.open(str(dst), "w", format=muxer or None) as out:
+    with av.open(local(src)) as inp, av.open(local(dst), "w", format=muxer or None) as out:
         video = inp.streams.video[0]
         streams = {s.index: out.add_stream_from_template(s) for s in inp.streams}
         out.metadata.update(inp.metadata)

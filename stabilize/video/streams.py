@@ -14,6 +14,7 @@ WebM keep it as the video's tag, and other containers lose it, with a notice.
 
 from __future__ import annotations
 
+from stabilize.video.binary import local
 from stabilize.video.containers import Container
 from stabilize.video.encode import Mux
 from stabilize.video.probe import Stream, VideoInfo
@@ -65,7 +66,7 @@ def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0
         if titles[index]:
             args += [f"-metadata:s:{out}", f"title={titles[index]}"]
     args += ["-map_chapters", "1" if container.chapters else "-1"]
-    return Mux((("-i", str(info.path)),), tuple(args), tuple(notices), video_delay)
+    return Mux((("-i", local(info.path)),), tuple(args), tuple(notices), video_delay)
 
 
 def _codec(stream: Stream, container: Container) -> tuple[str | None, str]:

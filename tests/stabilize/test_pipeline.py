@@ -204,6 +204,15 @@ def test_an_image_sequence_is_read_from_its_lowest_number_at_the_rate_given(shak
     assert np.allclose(np.diff(frame_times(out)), 1 / 24, atol=1e-3)
 
 
+def test_a_colon_in_a_relative_name_is_not_taken_for_a_protocol(shaky, tmp_path, monkeypatch):
+    # an ISO time in a name, as cameras and recorders write it: FFmpeg read "take:" as a
+    # protocol, and the clip was "not a video FFmpeg can read"
+    monkeypatch.chdir(tmp_path)
+    Path("take:10:11:12.mp4").write_bytes(shaky.read_bytes())
+    summary, _ = stabilize_video("take:10:11:12.mp4", "out:1.mp4", Settings(fov=70.0))
+    assert summary["frames"] == 60 and probe("out:1.mp4").has_audio
+
+
 def test_a_deep_source_keeps_the_encoder_asked_for(shaky, tmp_path):
     ten = tmp_path / "ten.mp4"
     cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-t", "1", "-c:v", "libx264"]
