@@ -11,6 +11,7 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+from stabilize.video.containers import container_for
 from stabilize.video.sequence import is_pattern, sequence_files
 
 
@@ -20,13 +21,19 @@ def check_absent(path: str | os.PathLike, overwrite: bool) -> None:
     final = Path(path)
     if overwrite:
         return
-    if is_pattern(final) and (found := sequence_files(final)):
+    if is_sequence(final) and (found := sequence_files(final)):
         raise FileExistsError(
             f"{final}: {len(found)} pictures of this sequence exist (use --overwrite to "
             "replace them)"
         )
     if final.exists():
         raise FileExistsError(f"{final} exists (use --overwrite to replace it)")
+
+
+def is_sequence(path: Path) -> bool:
+    """Whether an output is an image sequence: a pattern in a picture format's suffix
+    (``frames/%05d.png``; a video named ``50%done.mp4`` is one file)."""
+    return is_pattern(path) and container_for(path).pictures is not None
 
 
 @contextlib.contextmanager
@@ -43,7 +50,7 @@ def atomic_output(path: str | os.PathLike, *, overwrite: bool = False) -> Iterat
     final = Path(path)
     check_absent(final, overwrite)
     final.parent.mkdir(parents=True, exist_ok=True)
-    if is_pattern(final):
+    if is_sequence(final):
         with _atomic_sequence(final) as tmp:
             yield tmp
         return

@@ -19,12 +19,13 @@ _NUMBER = re.compile(r"%0?\d*d")  # the frame number's place in a pattern: %d, %
 
 
 def is_pattern(path: str | Path) -> bool:
-    """Whether ``path`` names an image sequence: its file name holds a frame number.
+    """Whether ``path`` names an image sequence: its file name holds a frame number, and
+    no file has that very name (a clip called ``50%done.mp4`` is a clip).
 
     >>> is_pattern("frames/img-%05d.jpg"), is_pattern("out/%d.png"), is_pattern("a%20b.mp4")
     (True, True, False)
     """
-    return bool(_NUMBER.search(Path(path).name))
+    return bool(_NUMBER.search(Path(path).name)) and not Path(path).is_file()
 
 
 def sequence_files(pattern: str | Path) -> dict[int, Path]:

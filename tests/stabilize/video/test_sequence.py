@@ -94,3 +94,13 @@ def test_a_phones_photos_held_upright_are_read_and_written_upright(shaky, tmp_pa
     out = tmp_path / "out.mp4"
     summary, _ = stabilize_video(pattern, out, Settings(fov=70.0))
     assert probe(out).size == shown[0].shape[:2] and summary["frames"] == 15
+
+
+def test_a_clip_whose_name_holds_a_percent_d_is_a_clip(shaky, tmp_path):
+    clip = tmp_path / "50%done.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-t", "0.5", "-c", "copy", str(clip)]
+    subprocess.run(cmd, check=True)
+    assert probe(clip).width > 0  # before, "no file matches this pattern"
+    out = tmp_path / "take%d.mp4"  # one video, not a sequence of them
+    summary, _ = stabilize_video(clip, out, Settings(fov=70.0))
+    assert out.is_file() and probe(out).codec == "h264" and summary["frames"] > 10
