@@ -58,7 +58,9 @@ def read_frames(
         # away anyway; skipping it makes the decode about 20% faster. (Not where only an
         # anamorphic stream's pixels are narrowed, DV's 720 to 640: that is the output.)
         options["skip_loop_filter"] = "all"
-    stream = ffmpeg.input(local(path), **options)
+    # the first video stream, as probe lists it: FFmpeg's own choice is the largest, and
+    # a dashcam's front camera after its smaller rear one was read at the rear's size
+    stream = ffmpeg.input(local(path), **options)["v:0"]
     if exif_turn:
         for name, value in TURN_FILTERS[info.rotation]:
             stream = stream.filter(name, value) if value else stream.filter(name)

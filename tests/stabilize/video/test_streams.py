@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from stabilize import Settings, stabilize_video
-from stabilize.video import Encoding, FrameWriter, ffmpeg_exe, probe
+from stabilize.video import Encoding, FrameWriter, ffmpeg_exe, probe, read_frames
 from stabilize.video.containers import container_for
 from stabilize.video.streams import keep_streams
 
@@ -131,6 +131,21 @@ def test_a_second_video_stream_is_left_out_and_said_so(shaky, tmp_path):
     subprocess.run([*cmd, "-map", "0:a", "-c", "copy", str(two)], check=True)
     mux = keep_streams(probe(two), container_for("out.mp4"))
     assert mux.notices == ("left out video #1 (h264): only the first video stream is stabilised",)
+
+
+def test_the_first_video_stream_is_the_one_decoded_when_a_larger_one_follows(shaky, tmp_path):
+    # a dashcam's rear camera first, its front camera, larger, second: FFmpeg's own choice
+    # is the largest, which was read at the first one's size, garbled
+    rear = tmp_path / "rear.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-t", "1", "-vf", "scale=160:90"]
+    subprocess.run([*cmd, "-an", str(rear)], check=True)
+    two = tmp_path / "two.mkv"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(rear), "-i", str(shaky), "-map", "0:v"]
+    subprocess.run([*cmd, "-map", "1:v", "-c", "copy", str(two)], check=True)
+    info = probe(two)
+    assert info.size == (90, 160)
+    got, want = next(read_frames(two, info=info)), next(read_frames(rear))
+    assert np.abs(got.astype(int) - want).mean() < 1
 
 
 def test_hevc_in_mp4_is_tagged_hvc1(tmp_path):
