@@ -51,6 +51,7 @@ from stabilize.video.colour import DOLBY_BASE
 from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Encoding, Mux
 from stabilize.video.fields import DEINTERLACE_MODES
+from stabilize.video.i420 import has_alpha
 from stabilize.video.preflight import check_encoder, check_writable, describe
 from stabilize.video.sequence import first_image, sequence_args
 from stabilize.video.streams import keep_streams
@@ -192,6 +193,11 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
             notices += ("an image sequence keeps no frame times (--report's path.csv has them)",)
     notices += encoder_notice(encoding, settings.encoding.codec_for(container))
     notices += dolby_vision_notice(info.colour.dolby_vision)
+    if has_alpha(info.pix_fmt):
+        notices += (
+            f"the source's alpha (transparency, {info.pix_fmt}) is left out: the frames "
+            "are stabilised and written without it",
+        )
     if info.colour.hdr10_lost(encoding.codec):
         notices += (
             f"HDR10's mastering display and light levels left out: {encoding.codec} does "

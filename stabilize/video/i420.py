@@ -39,6 +39,16 @@ def pipe_format(source_pix_fmt: str) -> str:
     return "yuv420p10le" if depth and int(depth.group(1)) >= 10 else "yuv420p"
 
 
+def has_alpha(pix_fmt: str) -> bool:
+    """Whether FFmpeg's pixel format carries an alpha (transparency) plane, which the
+    I420 pipe does not: ProRes 4444's ``yuva444p12le``, a PNG's ``rgba``.
+
+    >>> [has_alpha(f) for f in ("yuva444p12le", "rgba", "gbrap", "yuv420p", "pal8")]
+    [True, True, True, False, False]
+    """
+    return bool(re.match(r"(yuva|rgba|argb|bgra|abgr|gbrap|ya\d)", pix_fmt))
+
+
 def pipe_layout(pix_fmt: str, size: tuple[int, int]) -> tuple[tuple[int, ...], type]:
     """(shape, dtype) of one raw frame of (H, W) pixels in FFmpeg's ``pix_fmt``: I420
     (3H/2, W), 8 or 10 bits (``yuv420p10le``: uint16), else RGB (H, W, 3) uint8."""

@@ -104,3 +104,11 @@ def test_a_clip_whose_name_holds_a_percent_d_is_a_clip(shaky, tmp_path):
     out = tmp_path / "take%d.mp4"  # one video, not a sequence of them
     summary, _ = stabilize_video(clip, out, Settings(fov=70.0))
     assert out.is_file() and probe(out).codec == "h264" and summary["frames"] > 10
+
+
+def test_an_alpha_plane_left_out_is_said(shaky, tmp_path):
+    pattern = tmp_path / "a%03d.png"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-frames:v", "10", "-pix_fmt", "rgba"]
+    subprocess.run([*cmd, str(pattern)], check=True)
+    summary, _ = stabilize_video(pattern, tmp_path / "out.mp4", Settings(fov=70.0))
+    assert any("alpha (transparency, rgba) is left out" in n for n in summary["notices"])
