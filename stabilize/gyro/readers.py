@@ -7,14 +7,15 @@ in the sensor's own axes. :func:`read_gyro` detects the format from the file.
   lines (``tscale``, ``gscale``, ``orientation``, ...), then ``t,gx,gy,gz[,ax,ay,az]``.
 * ``sensorlogger``: Sensor Logger's ``Gyroscope.csv``: ``time,seconds_elapsed,z,y,x``
   (columns read by name; ``time`` in ns).
-* ``csv``: any CSV with a header naming a time column and x, y, z rate columns; units
-  and time unit are options.
+* ``csv``: any CSV with a header naming a time column and x, y, z rate columns (phyphox's
+  export among them); units as the header names them in brackets, else options.
 * ``telemetry``: gyro embedded in a camera's video file, read by ``telemetry-parser``.
 """
 
 from __future__ import annotations
 
 import csv
+import re
 from pathlib import Path
 
 import numpy as np
@@ -160,29 +161,58 @@ def read_gcsv(path: str | Path) -> GyroLog:
     return GyroLog(data[:, 0] * tscale, rates, str(path), readout_s)
 
 
+# Units a header may name in brackets ("Time (s)", "Gyroscope x (rad/s)", "gx [deg/s]")
+HEADER_TIME_UNITS = {"s": "s", "sec": "s", "ms": "ms", "us": "us", "µs": "us", "ns": "ns"}
+HEADER_RATE_UNITS = {"rad/s": "rad/s", "deg/s": "deg/s", "°/s": "deg/s", "dps": "deg/s"}
+_UNIT = re.compile(r"\s*[(\[]([^)\]]*)[)\]]\s*$")
+_SENSOR_WORDS = re.compile(r"^(gyroscope|gyro|angular velocity|rotation rate)[\s_]+")
+
+
+def _column(name: str) -> tuple[str, str]:
+    """A header's column name and the unit it names in brackets, normalised:
+    ``"Gyroscope x (rad/s)"`` → ``("x", "rad/s")`` (phyphox's export), ``"t"`` → ``("t", "")``.
+
+    >>> _column('"Time (s)"'), _column("Gyroscope x (rad/s)"), _column("gz [deg/s]")
+    (('time', 's'), ('x', 'rad/s'), ('gz', 'deg/s'))
+    """
+    name = name.strip().strip('"').strip().lower()
+    unit = _UNIT.search(name)
+    if unit:
+        name = name[: unit.start()]
+    return _SENSOR_WORDS.sub("", name.strip()), unit.group(1).strip() if unit else ""
+
+
+def _delimiter(header: str) -> str:
+    """The header's field separator: ``;`` (a spreadsheet's where the decimal mark is a
+    comma), a tab, else a comma."""
+    return max((";", "\t"), key=header.count) if ";" in header or "\t" in header else ","
+
+
 def read_named_csv(
     path: str | Path,
     *,
     time_column: str | None = None,
     columns: tuple[str, str, str] | None = None,
-    time_unit: str = "s",
-    rate_unit: str = "rad/s",
+    time_unit: str | None = None,
+    rate_unit: str | None = None,
 ) -> GyroLog:
     """A CSV with a header: the time column and x, y, z rate columns, read by name.
 
     Sensor Logger's ``Gyroscope.csv`` (``time`` in ns, ``seconds_elapsed``, ``z,y,x``)
-    is read with its own names and units when no others are given.
+    is read with its own names and units when no others are given. Units the header
+    names in brackets are used where none is given (phyphox's ``Time (s)``,
+    ``Gyroscope x (rad/s)``); else seconds and rad/s. Fields may be separated by commas,
+    tabs or semicolons, and with semicolons the decimal mark may be a comma, as a
+    spreadsheet in many languages writes them.
     """
     path = Path(path)
     if not path.is_file():
         raise GyroError(f"{path}: no such gyro log")
-    if time_unit not in TIME_UNITS or rate_unit not in RATE_UNITS:
-        raise GyroError(
-            f"time unit must be one of {list(TIME_UNITS)}, rate unit one of {list(RATE_UNITS)}"
-        )
-    with open(path, newline="", errors="replace") as f:
-        reader = csv.reader(f)
-        names = [n.strip().lower() for n in next(reader, [])]
+    with open(path, newline="", encoding="utf-8-sig", errors="replace") as f:
+        header = f.readline()
+        delimiter = _delimiter(header)
+        named = [_column(n) for n in next(csv.reader([header], delimiter=delimiter), [])]
+        names = [n for n, _ in named]
         sensorlogger = {"seconds_elapsed", "x", "y", "z"} <= set(names)
         if time_column is None:
             time_column = (
@@ -196,14 +226,25 @@ def read_named_csv(
         if missing:
             raise GyroError(f"{path}:1: no column named {', '.join(missing)} (have {names})")
         idx = [names.index(c) for c in wanted]
+        units = [named[i][1] for i in idx]
+        time_unit = time_unit or HEADER_TIME_UNITS.get(units[0], "s")
+        rate_unit = rate_unit or next(
+            (HEADER_RATE_UNITS[u] for u in units[1:] if u in HEADER_RATE_UNITS), "rad/s"
+        )
+        if time_unit not in TIME_UNITS or rate_unit not in RATE_UNITS:
+            raise GyroError(
+                f"time unit must be one of {list(TIME_UNITS)}, rate unit one of {list(RATE_UNITS)}"
+            )
+        decimal_comma = delimiter != ","
         rows = []
-        for number, row in enumerate(reader, start=2):
+        for number, row in enumerate(csv.reader(f, delimiter=delimiter), start=2):
             if not row or not "".join(row).strip():
                 continue
             if len(row) != len(names):
                 raise GyroError(f"{path}:{number}: expected {len(names)} fields, got {len(row)}")
             try:
-                rows.append([float(row[i]) for i in idx])
+                fields = [row[i].replace(",", ".") if decimal_comma else row[i] for i in idx]
+                rows.append([float(v) for v in fields])
             except ValueError:
                 raise GyroError(f"{path}:{number}: not a number") from None
     if not rows:

@@ -91,6 +91,35 @@ def test_plain_csv_with_units(tmp_path):
     np.testing.assert_allclose(log.times, [0.0, 0.005, 0.01])
 
 
+def test_phyphox_export_units_from_its_header(tmp_path):
+    # phyphox's "Gyroscope" experiment, exported as CSV (comma, decimal point)
+    head = '"Time (s)","Gyroscope x (rad/s)","Gyroscope y (rad/s)","Gyroscope z (rad/s)",'
+    text = (
+        head
+        + '"Absolute (rad/s)"\n'
+        + "".join(
+            f"{0.01 * k:.9E},{x:.9E},{y:.9E},{z:.9E},{np.linalg.norm([x, y, z]):.9E}\n"
+            for k, (x, y, z) in enumerate(RATES)
+        )
+    )
+    path = write(tmp_path, "Raw Data.csv", "\ufeff" + text)  # with a byte-order mark
+    assert detect_format(path) == "csv"
+    log = read_gyro(path)
+    np.testing.assert_allclose(log.rates, RATES)
+    np.testing.assert_allclose(log.times, [0.0, 0.01, 0.02])
+
+
+def test_a_spreadsheets_csv_with_decimal_commas_and_units_in_brackets(tmp_path):
+    # semicolons between fields, commas for decimals, as a German or French locale writes
+    text = "time [ms];gx [deg/s];gy [deg/s];gz [deg/s]\n" + "".join(
+        f"{5 * k};{np.degrees(x):.6f};{np.degrees(y):.6f};{np.degrees(z):.6f}\n".replace(".", ",")
+        for k, (x, y, z) in enumerate(RATES)
+    )
+    log = read_gyro(write(tmp_path, "imu.csv", text))
+    np.testing.assert_allclose(log.rates, RATES, atol=1e-7)
+    np.testing.assert_allclose(log.times, [0.0, 0.005, 0.01])
+
+
 @pytest.mark.parametrize(
     ("name", "text", "message"),
     [
