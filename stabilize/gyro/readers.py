@@ -202,8 +202,8 @@ def read_named_csv(
     is read with its own names and units when no others are given. Units the header
     names in brackets are used where none is given (phyphox's ``Time (s)``,
     ``Gyroscope x (rad/s)``); else seconds and rad/s. Fields may be separated by commas,
-    tabs or semicolons, and with semicolons the decimal mark may be a comma, as a
-    spreadsheet in many languages writes them.
+    tabs or semicolons, and where they are not commas the decimal mark may be a comma,
+    as a spreadsheet in many languages writes them.
     """
     path = Path(path)
     if not path.is_file():
