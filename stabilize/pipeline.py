@@ -193,6 +193,11 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
             notices += ("an image sequence keeps no frame times (--report's path.csv has them)",)
     notices += encoder_notice(encoding, settings.encoding.codec_for(container))
     notices += dolby_vision_notice(info.colour.dolby_vision)
+    if info.captions:
+        notices += (
+            "closed captions (EIA-608/708, carried in the video's frames) left out: they "
+            "do not travel through the pipe to the encoder",
+        )
     if has_alpha(info.pix_fmt):
         notices += (
             f"the source's alpha (transparency, {info.pix_fmt}) is left out: the frames "

@@ -78,6 +78,9 @@ class VideoInfo:
     # them (``size``), and the bars are put back around it on writing
     bars: tuple[int, int, int, int] | None = None
     framed: tuple[int, int] | None = None
+    # closed captions (EIA-608/708, a broadcast's) carried in the video's own frames,
+    # which FFmpeg's listing names on the stream's line
+    captions: bool = False
 
     @property
     def size(self) -> tuple[int, int]:
@@ -285,4 +288,5 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
         deinterlace=interlaced(order),
         pixel_aspect=f"{aspect.numerator}:{aspect.denominator}",
         coded=coded,
+        captions="Closed Captions" in stream_line,
     )

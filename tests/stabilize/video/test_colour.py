@@ -175,3 +175,17 @@ def test_dolby_vision_is_read_from_the_video_streams_own_listing(tmp_path, monke
     second = video.replace("#0:0[0x1]", "#0:1[0x2]") + "      Side data:\n" + record
     plain = video + second + "  Stream #0:2" + audio
     assert listed(plain).dolby_vision is None
+
+
+def test_closed_captions_in_the_video_are_read_from_its_line(tmp_path, monkeypatch):
+    # a US broadcast recording: EIA-608 captions in the H.264 frames' SEI
+    clip = tmp_path / "news.ts"
+    clip.write_bytes(b"")
+    listing = IPHONE_HDR.split("      Metadata")[0].replace(
+        "1920x1080, 19000 kb/s", "1920x1080 [SAR 1:1 DAR 16:9], Closed Captions"
+    )
+    result = subprocess.CompletedProcess([], 1, "", listing)
+    monkeypatch.setattr(subprocess, "run", lambda *a, **k: result)
+    assert probe(clip).captions
+    result.stderr = IPHONE_HDR
+    assert not probe(clip).captions
