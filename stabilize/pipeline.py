@@ -396,7 +396,7 @@ def _write(
     ``dst``, never the temporary file."""
     with atomic_output(dst, overwrite=overwrite) as tmp:
         try:
-            return render(src, tmp, job.info, planned, settings, progress, job.mux)
+            return render(src, tmp, job.info, planned, settings, job.encoding, progress, job.mux)
         except EncodeError as err:
             named = str(err).replace(local(tmp), str(dst)).replace(str(tmp), str(dst))
             raise EncodeError(named) from None

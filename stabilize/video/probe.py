@@ -252,7 +252,7 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     rot = _ROTATION.search(text)
     rotation = int(round(float(rot.group(1) or rot.group(2)))) % 360 if rot else 0
     if pattern and not rot:  # an image's EXIF orientation, which FFmpeg does not list
-        rotation = exif_rotation(path, first_image(input_args))
+        rotation = exif_rotation(path, first)
     sar = _SAR.search(stream_line)
     aspect = Fraction(int(sar.group(1)), int(sar.group(2))) if sar and int(sar.group(2)) else 0
     aspect = aspect or Fraction(1)  # none, or 0:1 ("unknown"): square

@@ -37,11 +37,13 @@ def render(
     info: VideoInfo,
     planned: CameraPath,
     settings: Settings,
+    encoding: Encoding,
     progress: Progress = no_progress,
     mux: Mux | None = None,
 ) -> int:
-    """Decode, warp, encode into the container ``out``'s suffix names, with what ``mux``
-    keeps of the source (default: nothing but the video); returns frames written.
+    """Decode, warp, encode into the container ``out``'s suffix names, by ``encoding``
+    (:func:`output_encoding`, resolved once before any work), with what ``mux`` keeps of
+    the source (default: nothing but the video); returns frames written.
 
     A variable-frame-rate clip is encoded at its nominal rate without B-frames, then its
     packets are restamped with the source's own frame times (:func:`retime`).
@@ -55,7 +57,6 @@ def render(
     variable = container.timed and is_variable_rate(planned.times)
     pix_fmt = piped_format(info, settings)
     planar = pix_fmt != "rgb24"
-    encoding = output_encoding(info, settings, container)
     encoding = replace(encoding, b_frames=False) if variable else encoding
     target = out.with_name(f"{out.stem}.cfr{out.suffix}") if variable else out
     side_by_side = i420.hstack if planar else lambda a, b: np.hstack([a, b])
