@@ -41,7 +41,7 @@ from stabilize.motion.track import VisualTrack
 from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoInfo
-from stabilize.video.sequence import first_image
+from stabilize.video.sequence import first_image, picture
 from stabilize.warp.lens import Lens
 
 FULL_FRAME_DIAGONAL_MM = 43.27
@@ -102,7 +102,7 @@ def _tag_35mm(text: str) -> float | None:
 def _exif_35mm(info: VideoInfo) -> float | None:
     """FocalLengthIn35mmFilm (tag 41989) of the first image of a %d pattern."""
     number = first_image(info.input_args)
-    first = Path(str(info.path) % (1 if number is None else number))
+    first = picture(info.path, 1 if number is None else number)
     try:
         from PIL import Image
 

@@ -13,6 +13,8 @@ import subprocess
 from collections.abc import Sequence
 from pathlib import Path
 
+from stabilize.video.sequence import image2_path
+
 
 @functools.cache
 def ffmpeg_exe() -> str:
@@ -24,15 +26,18 @@ def ffmpeg_exe() -> str:
     return imageio_ffmpeg.get_ffmpeg_exe()
 
 
-def local(path: str | Path) -> str:
+def local(path: str | Path, image2: bool = False) -> str:
     """``path`` as FFmpeg reads a local file whatever its name: absolute, so that a
     colon in a relative name (``take:2.mp4``, an ISO time ``10:11:12.mp4``) is not
-    taken for a protocol's, which made such a clip "not a video FFmpeg can read".
+    taken for a protocol's, which made such a clip "not a video FFmpeg can read". An
+    image sequence's pattern (``image2``) has its other ``%`` escaped
+    (:func:`~stabilize.video.sequence.image2_path`).
 
-    >>> local("/clips/take:2.mp4")
-    '/clips/take:2.mp4'
+    >>> local("/clips/take:2.mp4"), local("/clips/50%/%d.png", image2=True)
+    ('/clips/take:2.mp4', '/clips/50%%/%d.png')
     """
-    return os.path.abspath(path)
+    full = os.path.abspath(path)
+    return image2_path(full) if image2 else full
 
 
 PIPE_BYTES = 1 << 20  # Linux's default ceiling for an unprivileged pipe
@@ -55,6 +60,6 @@ def filter_log(
     """What FFmpeg's video filters ``chain`` log (its stderr) over the first video
     stream of ``path``, decoded and thrown away: ``before`` are input options (which
     frames to decode), ``after`` output ones (how many to pass)."""
-    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *before, "-i", local(path)]
+    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *before, "-i", local(path, "image2" in before)]
     cmd += ["-map", "0:v:0", "-vf", chain, *after, "-f", "null", "-"]
     return subprocess.run(cmd, capture_output=True, text=True, errors="replace").stderr

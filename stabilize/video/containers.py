@@ -48,6 +48,8 @@ class Container:
     # for an 8-bit source and for a deeper one (None: the pipe's 4:2:0 at its depth)
     pictures: tuple[str, str] | None = None
     name: str = ""  # how notices name it (default: its muxer's name)
+    # Attached files (the fonts an ASS subtitle track is drawn with), Matroska's alone
+    attachments: bool = False
 
     @property
     def timed(self) -> bool:
@@ -110,6 +112,8 @@ CONTAINERS: dict[str, Container] = {
         subtitle_encoder="srt",
         deep_encoder="libx265",
         timecode="tag",
+        attachments=True,
+        name="Matroska",
     ),
     ".webm": Container(
         "webm",
@@ -119,6 +123,7 @@ CONTAINERS: dict[str, Container] = {
         frozenset({"webvtt"}),
         "webvtt",
         timecode="tag",
+        name="WebM",
     ),
     ".avi": Container(
         "avi",
@@ -133,6 +138,7 @@ CONTAINERS: dict[str, Container] = {
         subtitles=frozenset({"dvb_subtitle"}),
         chapters=False,
         deep_encoder="libx265",
+        name="MPEG-TS",
     ),
     # OUT a pattern (frames/%05d.png): a picture per frame, at 16 bits a channel for a
     # source of 10 bits or more where the format holds them (PNG, TIFF)

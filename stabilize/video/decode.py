@@ -60,7 +60,7 @@ def read_frames(
         options["skip_loop_filter"] = "all"
     # the first video stream, as probe lists it: FFmpeg's own choice is the largest, and
     # a dashcam's front camera after its smaller rear one was read at the rear's size
-    stream = ffmpeg.input(local(path), **options)["v:0"]
+    stream = ffmpeg.input(local(path, "image2" in args), **options)["v:0"]
     if exif_turn:
         for name, value in TURN_FILTERS[info.rotation]:
             stream = stream.filter(name, value) if value else stream.filter(name)
@@ -141,8 +141,8 @@ def _framecrc_times(path: str | Path, input_args: tuple, *, decode: bool) -> np.
     """Sorted frame times from FFmpeg's framecrc of the first video stream: its packets
     (``decode`` False) or its decoded frames; None where some carry no timestamp."""
     codec = ["-c:v", "wrapped_avframe"] if decode else ["-c", "copy"]
-    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i", local(path)]
-    cmd += ["-map", "0:v:0", *codec, "-f", "framecrc", "-"]
+    cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i"]
+    cmd += [local(path, "image2" in input_args), "-map", "0:v:0", *codec, "-f", "framecrc", "-"]
     result = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
     tb = re.search(r"#tb 0: (\d+)/(\d+)", result.stdout)
     if "partial file" in result.stderr:

@@ -146,10 +146,12 @@ class FrameWriter:
         cmd += [*raw, *piped.ffmpeg_args(), "-i", "pipe:"]
         for extra in mux.inputs:
             cmd += list(extra)
-        cmd += ["-map", "0:v", *mux.args, *_delayed(mux.video_delay)]
-        codec = encoding.codec_for(container or container_for(path))
+        # the video is the track players show: Matroska otherwise marks it not the default
+        cmd += ["-map", "0:v", "-disposition:v:0", "default", *mux.args, *_delayed(mux.video_delay)]
+        container = container or container_for(path)
+        codec = encoding.codec_for(container)
         cmd += [*output_args(path, encoding, container), *colour.ffmpeg_args()]
-        cmd += [*colour.hdr10_args(codec), local(path)]
+        cmd += [*colour.hdr10_args(codec), local(path, container.pictures is not None)]
         self._process = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
         widen_pipe(self._process.stdin)
 

@@ -42,6 +42,8 @@ class Stream:
     tag: str = ""  # the container's codec tag, e.g. 'avc1', 'text'
     title: str = ""  # its title ('name' in MP4, which FFmpeg writes back under another key)
     timecode: str = ""  # SMPTE start timecode (HH:MM:SS:FF), where the stream carries one
+    cover: bool = False  # a cover picture (FFmpeg's "attached pic"): one still, not a video
+    filename: str = ""  # an attached file's name (a font's, in Matroska)
 
 
 @dataclass(frozen=True)
@@ -189,6 +191,7 @@ def _stream(match: re.Match, text: str) -> Stream:
     start = re.search(r", start (-?\d+(?:\.\d+)?)", line)
     tag = re.search(r"\((\w+) / 0x[0-9A-Fa-f]+\)", line)
     timecode = re.search(r"^\s+timecode\s*: (\S+)", block, re.M | re.I)  # MKV: TIMECODE
+    filename = re.search(r"^\s+filename\s*: (.*)$", block, re.M | re.I)
     return Stream(
         int(match.group(1)),
         match.group(3).lower(),
@@ -198,6 +201,8 @@ def _stream(match: re.Match, text: str) -> Stream:
         tag.group(1) if tag else "",
         title.group(1).strip() if title else "",
         timecode.group(1) if timecode else "",
+        "(attached pic)" in line,
+        filename.group(1).strip() if filename else "",
     )
 
 
@@ -232,7 +237,7 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     if path.is_dir():
         raise VideoError(f"{path}: is a folder, not a video (give a pattern like dir/img-%d.jpg)")
     result = subprocess.run(
-        [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i", local(path)],
+        [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i", local(path, pattern)],
         capture_output=True,
         text=True,
         errors="replace",

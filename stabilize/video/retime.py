@@ -57,6 +57,7 @@ def retime(
         out.metadata.update(inp.metadata)
         for s in inp.streams:
             streams[s.index].metadata.update(s.metadata)
+            streams[s.index].disposition = s.disposition  # which track plays by default
         if inp.chapters():
             out.set_chapters(inp.chapters())
         streams[video.index].time_base = Fraction(1, TIMESCALE)

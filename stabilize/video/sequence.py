@@ -10,6 +10,7 @@ folder beside the target and moved into place once every frame is written
 
 from __future__ import annotations
 
+import os
 import re
 from itertools import pairwise
 from pathlib import Path
@@ -26,6 +27,39 @@ def is_pattern(path: str | Path) -> bool:
     (True, True, False)
     """
     return bool(_NUMBER.search(Path(path).name)) and not Path(path).is_file()
+
+
+def image2_path(pattern: str | Path) -> str:
+    """An image-sequence pattern as FFmpeg's image2 reads it: every ``%`` but the frame
+    number's doubled, since FFmpeg takes a ``%`` anywhere in the path, its folders' names
+    included, for a number's place, and a folder named ``a100%b`` made every picture
+    "the same name".
+
+    >>> image2_path("/clips/100% sharp/img%-%05d.png")
+    '/clips/100%% sharp/img%%-%05d.png'
+    """
+    folder, name = os.path.split(str(pattern))
+    number = _NUMBER.search(name)
+    if number is None:
+        return str(pattern).replace("%", "%%")
+    head, tail = name[: number.start()], name[number.end() :]
+    name = head.replace("%", "%%") + number.group() + tail.replace("%", "%%")
+    return os.path.join(folder.replace("%", "%%"), name)
+
+
+def picture(pattern: str | Path, number: int) -> Path:
+    """The file of image ``number`` of a pattern: only the name's frame number filled in
+    (Python's ``%`` would take one in a folder's name for a format of its own).
+
+    >>> picture("/clips/50% off/img-%05d.jpg", 99).as_posix()
+    '/clips/50% off/img-00099.jpg'
+    """
+    path = Path(pattern)
+    number_at = _NUMBER.search(path.name)
+    if number_at is None:
+        return path
+    head, tail = path.name[: number_at.start()], path.name[number_at.end() :]
+    return path.with_name(head + number_at.group() % number + tail)
 
 
 def sequence_files(pattern: str | Path) -> dict[int, Path]:
@@ -62,7 +96,7 @@ def exif_rotation(pattern: str | Path, number: int) -> int:
     try:
         from PIL import Image
 
-        with Image.open(str(pattern) % number) as image:
+        with Image.open(picture(pattern, number)) as image:
             return EXIF_ROTATION.get(int(image.getexif().get(0x0112, 1)), 0)
     except (OSError, ValueError, ImportError):
         return 0

@@ -1,6 +1,7 @@
 """Keeping what the user gave us: every audio and subtitle track of the source, its
-chapters and its metadata, and the data tracks the container can hold (GoPro's GPMF
-telemetry in MP4 and MOV), muxed beside the stabilised video.
+chapters and its metadata, and the data tracks and attached files the container can hold
+(GoPro's GPMF telemetry in MP4 and MOV, an ASS subtitle track's fonts in Matroska), muxed
+beside the stabilised video.
 
 Each track is copied when the output container holds it as it is, transcoded when it
 does not (AAC into WebM becomes Opus, mov_text into MKV becomes SRT), and left out only
@@ -30,7 +31,7 @@ def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0
         return Mux()
     args: list[str] = []
     notices: list[str] = []
-    count = {"a": 0, "s": 0, "d": 0}
+    count = {"a": 0, "s": 0, "d": 0, "t": 0}
     kept: list[int] = []
     timecode = _timecode(info)
     for stream in info.streams:
@@ -38,14 +39,12 @@ def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0
             continue
         codec, flag = _codec(stream, container)
         where = _name(container)
-        if stream.kind == "video":  # a second camera's, a proxy's, a cover picture
-            notices.append(
-                f"left out video #{stream.index} ({stream.codec}): only the first video "
-                "stream is stabilised"
-            )
+        if stream.kind == "video":
+            notices.append(_video_left_out(stream))
             continue
         if codec is None:
-            what = stream.codec if stream.codec != "none" else stream.tag  # e.g. GoPro's fdsc
+            # GoPro's fdsc has no codec, only a tag; an attached font, only its name
+            what = stream.filename or (stream.codec if stream.codec != "none" else stream.tag)
             notices.append(
                 f"left out {stream.kind} #{stream.index} ({what}): {where} cannot hold it"
                 + (_where_timecode(timecode, container) if _is_timecode(stream) else "")
@@ -76,8 +75,21 @@ def _codec(stream: Stream, container: Container) -> tuple[str | None, str]:
         return container.audio_codec(stream.codec), "a"
     if stream.kind == "subtitle":
         return container.subtitle_codec(stream.codec), "s"
+    if stream.kind == "attachment":
+        return ("copy" if container.attachments else None), "t"
     held = stream.kind == "data" and stream.tag in container.data
     return ("copy" if held else None), "d"
+
+
+def _video_left_out(stream: Stream) -> str:
+    """The notice for a video stream other than the stabilised one."""
+    if stream.cover:  # a thumbnail, as yt-dlp embeds one
+        # FFmpeg writes a cover only as MP4's iTunes-style cover atom, which the QuickTime
+        # metadata keys that carry a phone's tags rule out; it drops one in MOV, and makes
+        # one a video track of a single frame in Matroska
+        return f"left out the cover picture (#{stream.index}, {stream.codec}): covers are not kept"
+    what = f"video #{stream.index} ({stream.codec})"  # a second camera's, a proxy's
+    return f"left out {what}: only the first video stream is stabilised"
 
 
 def _rebuilt(stream: Stream, info: VideoInfo, container: Container) -> bool:

@@ -112,3 +112,17 @@ def test_an_alpha_plane_left_out_is_said(shaky, tmp_path):
     subprocess.run([*cmd, str(pattern)], check=True)
     summary, _ = stabilize_video(pattern, tmp_path / "out.mp4", Settings(fov=70.0))
     assert any("alpha (transparency, rgba) is left out" in n for n in summary["notices"])
+
+
+def test_a_percent_in_a_folders_or_files_name_is_not_a_frame_number(shaky, tmp_path):
+    # FFmpeg took each for a number's place: the input was "not found", the output's
+    # every picture "the same name"; Python's % refused the folder's as a format
+    source = tmp_path / "50% off" / "img%-%03d.png"
+    source.parent.mkdir()
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-frames:v", "12"]
+    subprocess.run([*cmd, str(source).replace("%-", "%%-").replace("50%", "50%%")], check=True)
+    assert sorted(sequence_files(source)) == list(range(1, 13))
+    out = tmp_path / "a100%b" / "f%04d.png"
+    summary, _ = stabilize_video(source, out, Settings())  # --fov auto reads its EXIF
+    assert sorted(sequence_files(out)) == list(range(1, 13)) and summary["frames"] == 12
+    assert len(list(read_frames(out))) == 12

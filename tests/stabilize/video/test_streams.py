@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from stabilize import Settings, stabilize_video
-from stabilize.video import Encoding, FrameWriter, ffmpeg_exe, probe, read_frames
+from stabilize.video import Encoding, FrameWriter, ffmpeg_exe, frame_times, probe, read_frames
 from stabilize.video.containers import container_for
 from stabilize.video.streams import keep_streams
 
@@ -104,6 +104,13 @@ def test_the_files_metadata_is_kept(kept):
     assert tags["title"] == "Street walk" and tags["location"] == "+48.8584+002.2945/"
     if "creation_time" in kept[2]["source"][0]:
         assert tags["creation_time"].startswith("2024-05-01T10:00:00")
+
+
+def test_the_video_is_the_default_track(kept):
+    # Matroska marked the piped video not the default, which players read as "not shown"
+    with av.open(str(kept[0])) as c:
+        assert c.streams.video[0].disposition & av.stream.Disposition.default
+        assert c.streams.audio[0].disposition & av.stream.Disposition.default
 
 
 def test_webm_transcodes_what_it_cannot_hold_and_says_so(rich, tmp_path):
@@ -207,7 +214,7 @@ def test_matroska_keeps_the_timecode_as_the_videos_tag_and_says_so(timecoded, tm
     out = tmp_path / "out.mkv"
     summary, _ = stabilize_video(timecoded, out, Settings(fov=70.0))
     assert [n for n in summary["notices"] if "tmcd" in n] == [
-        f"left out data #1 (tmcd): MATROSKA cannot hold it; its timecode ({TIMECODE}) is kept "
+        f"left out data #1 (tmcd): Matroska cannot hold it; its timecode ({TIMECODE}) is kept "
         "as the video's tag"
     ]
     assert probe(out).streams[0].timecode == TIMECODE
@@ -218,3 +225,48 @@ def test_a_timecode_no_container_holds_is_said_lost(timecoded):
     assert [n for n in mux.notices if "tmcd" in n] == [
         f"left out data #1 (tmcd): AVI cannot hold it; its timecode ({TIMECODE}) is lost"
     ]
+
+
+@pytest.fixture(scope="module")
+def attached(shaky, tmp_path_factory) -> Path:
+    """The shaky clip at a variable frame rate as Matroska, with an ASS subtitle track,
+    the font it is drawn with attached, and a cover picture (as yt-dlp embeds one)."""
+    folder = tmp_path_factory.mktemp("attached")
+    (folder / "s.srt").write_text("1\n00:00:00,200 --> 00:00:01,500\nHello street\n")
+    cover = folder / "cover.png"
+    cmd = [ffmpeg_exe(), "-v", "error", "-y", "-f", "lavfi", "-i", "testsrc=s=64x64"]
+    subprocess.run([*cmd, "-frames:v", "1", str(cover)], check=True)
+    (folder / "font.ttf").write_bytes(FONT)
+    out = folder / "attached.mkv"
+    cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(shaky), "-i", str(folder / "s.srt")]
+    cmd += ["-map", "0:v", "-map", "0:a", "-map", "1", "-c:a", "copy", "-c:s", "ass"]
+    cmd += ["-vf", "setpts=(N+0.4*mod(N\\,3))/30/TB", "-fps_mode", "passthrough"]
+    for k, (path, mime) in enumerate(((folder / "font.ttf", "font/ttf"), (cover, "image/png"))):
+        cmd += ["-attach", str(path), f"-metadata:s:t:{k}", f"mimetype={mime}"]
+    subprocess.run([*cmd, str(out)], check=True)
+    kinds = [(s.kind, s.cover) for s in probe(out).streams]
+    assert kinds[3:] == [("attachment", False), ("video", True)]
+    return out
+
+
+FONT = b"\x00\x01\x00\x00" + bytes(range(256)) * 4  # kept byte for byte, not parsed
+
+
+def test_attached_files_are_kept_in_matroska_and_a_cover_is_said_left_out(attached, tmp_path):
+    # The fonts an ASS track is drawn with: "Matroska cannot hold it", they were left out
+    out = tmp_path / "out.mkv"
+    summary, _ = stabilize_video(attached, out, Settings(fov=70.0))
+    assert summary["notices"] == ["left out the cover picture (#4, png): covers are not kept"]
+    with av.open(str(out)) as c:
+        fonts = [s for s in c.streams if s.type == "attachment"]
+        assert [(s.name, s.mimetype, bytes(s.data)) for s in fonts] == [
+            ("font.ttf", "font/ttf", FONT)
+        ]
+        assert c.streams.video[0].disposition & av.stream.Disposition.default
+        assert c.streams.audio[0].disposition & av.stream.Disposition.default  # retimed
+    assert np.ptp(np.diff(frame_times(out))) > 0.01  # the variable rate's own remux
+
+
+def test_attached_files_no_container_but_matroska_holds_are_said_left_out(attached):
+    mux = keep_streams(probe(attached), container_for("out.mp4"))
+    assert "left out attachment #3 (font.ttf): MP4 cannot hold it" in mux.notices
