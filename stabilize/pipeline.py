@@ -51,13 +51,19 @@ from stabilize.video.colour import DOLBY_BASE
 from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Encoding, Mux
 from stabilize.video.fields import DEINTERLACE_MODES
-from stabilize.video.i420 import has_alpha
+from stabilize.video.i420 import chroma, has_alpha
 from stabilize.video.preflight import check_encoder, check_writable, describe
 from stabilize.video.sequence import first_image, sequence_args
 from stabilize.video.streams import keep_streams
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.lens import Lens, read_lens_profile
-from stabilize.warp.render import encoded_size, frame_size, output_encoding, render
+from stabilize.warp.render import (
+    encoded_size,
+    frame_size,
+    output_encoding,
+    piped_format,
+    render,
+)
 from stabilize.warp.rolling import RAMP_S, within_stretch
 
 
@@ -203,6 +209,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
             f"the source's alpha (transparency, {info.pix_fmt}) is left out: the frames "
             "are stabilised and written without it",
         )
+    notices += chroma_notice(info.pix_fmt, piped_format(info, settings), encoding.pix_fmt)
     if info.colour.hdr10_lost(encoding.codec):
         notices += (
             f"HDR10's mastering display and light levels left out: {encoding.codec} does "
@@ -226,6 +233,19 @@ def encoder_notice(encoding: Encoding, default: str) -> tuple[str, ...]:
         f"10-bit video: encoded with {encoding.codec}, which phones and most browsers play "
         f"at 10 bits, where {default} at 10 bits plays in few players (--codec {default} "
         "keeps it)",
+    )
+
+
+def chroma_notice(source: str, piped: str, written: str) -> tuple[str, ...]:
+    """A notice where the source's colour is finer than 4:2:0 (a camera's or ProRes's
+    4:2:2, 4:4:4, RGB pictures) and is halved on the way: the frames travel to the
+    encoder as 4:2:0 (``piped``), or are encoded so (``written``)."""
+    finer = chroma(source) in ("4:2:2", "4:4:0", "4:4:4")
+    if not finer or (chroma(piped) != "4:2:0" and chroma(written) != "4:2:0"):
+        return ()
+    return (
+        f"the source's {chroma(source)} colour ({source}) is halved to 4:2:0: the frames "
+        "travel to the encoder as 4:2:0",
     )
 
 

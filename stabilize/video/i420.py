@@ -49,6 +49,34 @@ def has_alpha(pix_fmt: str) -> bool:
     return bool(re.match(r"(yuva|rgba|argb|bgra|abgr|gbrap|ya\d)", pix_fmt))
 
 
+# FFmpeg's packed and semi-planar YUV formats, by their chroma subsampling (the planar
+# ones, yuv4XXp, name it themselves)
+_PACKED_CHROMA = {
+    "4:2:0": ("nv12", "nv21", "p010", "p012", "p016"),
+    "4:2:2": ("nv16", "nv20", "p210", "p212", "p216", "y210", "y212", "yuyv422", "uyvy422",
+              "yvyu422", "v210"),
+    "4:4:4": ("nv24", "nv42", "p410", "p412", "p416", "ayuv", "vuya", "vuyx", "xv30", "xv36",
+              "v30x", "y410", "y412"),
+}  # fmt: skip
+
+
+def chroma(pix_fmt: str) -> str | None:
+    """The chroma subsampling of FFmpeg's ``pix_fmt`` as J:a:b (RGB: ``4:4:4``), ``""``
+    for grey (no colour), None where unknown.
+
+    >>> [chroma(f) for f in ("yuv420p", "yuvj422p", "yuv422p10le", "gbrp", "gray", "p010le")]
+    ['4:2:0', '4:2:2', '4:2:2', '4:4:4', '', '4:2:0']
+    """
+    planar = re.match(r"yuvj?a?(4)(\d)(\d)p", pix_fmt)
+    if planar:
+        return ":".join(planar.groups())
+    if pix_fmt.startswith(("gray", "ya", "mono")):
+        return ""
+    if re.match(r"(0?(rgb|bgr)|(rgb|bgr|gbr|argb|abgr)|pal8|x2(rgb|bgr)|gbrap?)", pix_fmt):
+        return "4:4:4"
+    return next((j for j, names in _PACKED_CHROMA.items() if pix_fmt.startswith(names)), None)
+
+
 def pipe_layout(pix_fmt: str, size: tuple[int, int]) -> tuple[tuple[int, ...], type]:
     """(shape, dtype) of one raw frame of (H, W) pixels in FFmpeg's ``pix_fmt``: I420
     (3H/2, W), 8 or 10 bits (``yuv420p10le``: uint16), else RGB (H, W, 3) uint8."""
