@@ -86,7 +86,8 @@ CodecOption = Annotated[
     str | None,
     typer.Option(
         help="Video encoder (any FFmpeg has): default libx264, or libx265 for a source of "
-        "10 bits or more (H.264 at 10 bits plays in few players), or libvpx-vp9 for .webm; "
+        "10 bits or more (H.264 at 10 bits plays in few players), libvpx-vp9 for .webm, gif "
+        "for .gif; "
         "libx265 for HEVC, libsvtav1 for AV1."
     ),
 ]

@@ -70,7 +70,9 @@ def run(
         ..., metavar="IN", help="The shaky video, or an image sequence (frames/img-%d.jpg)."
     ),
     output_path: Path = typer.Argument(
-        ..., metavar="OUT", help="Where to write the result: a video, or pictures (f/%05d.png)."
+        ...,
+        metavar="OUT",
+        help="Where to write the result: a video, a GIF, or pictures (f/%05d.png).",
     ),
     flow_name: FlowOption = DEFAULTS.flow,
     raft_weights: RaftWeightsOption = None,

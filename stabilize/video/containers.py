@@ -48,6 +48,10 @@ class Container:
     # for an 8-bit source and for a deeper one (None: the pipe's 4:2:0 at its depth)
     pictures: tuple[str, str] | None = None
     name: str = ""  # how notices name it (default: its muxer's name)
+    # The encoder's own pixel format, where it takes no 4:2:0 video (GIF's palette)
+    pix_fmt: str | None = None
+    # FFmpeg filters the video passes before its encoder (GIF's palette)
+    video_filter: str = ""
     # Attached files (the fonts an ASS subtitle track is drawn with), Matroska's alone
     attachments: bool = False
 
@@ -95,6 +99,29 @@ def image_sequence(encoder: str, pictures: tuple[str, str]) -> Container:
         name="an image sequence",
     )
 
+
+def animation(muxer: str, encoder: str, **kwargs) -> Container:
+    """An animated picture (GIF): video only, looping for ever, as such pictures play;
+    audio, subtitles, data tracks and chapters left out with a notice. (Not animated
+    WebP: its frames cannot be restamped with a variable rate's times after encoding.)"""
+    return Container(
+        muxer,
+        encoder,
+        audio=frozenset(),
+        audio_encoder=None,
+        subtitles=frozenset(),
+        chapters=False,
+        options=("-loop", "0"),
+        **kwargs,
+    )
+
+
+# A palette of its own for each frame: one for the whole clip (FFmpeg's default) holds
+# every frame back until the last is seen, all of them in memory; dithered by error
+# diffusion, which bands least in a camera's smooth skies
+GIF_PALETTE = (
+    "split[a][b];[a]palettegen=stats_mode=single[p];[b][p]paletteuse=new=1:dither=sierra2_4a"
+)
 
 JPEG = image_sequence("mjpeg", ("yuvj420p", "yuvj420p"))  # full range, as JPEG files are
 TIFF = image_sequence("tiff", ("rgb24", "rgb48le"))
@@ -147,6 +174,7 @@ CONTAINERS: dict[str, Container] = {
     ".jpeg": JPEG,
     ".tif": TIFF,
     ".tiff": TIFF,
+    ".gif": animation("gif", "gif", pix_fmt="pal8", video_filter=GIF_PALETTE, name="GIF"),
 }
 
 

@@ -64,6 +64,8 @@ class Encoding:
         'rgb48be'
         """
         deep = pix_fmt_in == "yuv420p10le"
+        if container.pix_fmt:  # the encoder's own (GIF's palette)
+            return replace(self, codec=self.codec_for(container), pix_fmt=container.pix_fmt)
         if container.pictures:  # an image sequence's: RGB, or JPEG's full-range YUV
             return replace(self, codec=self.codec_for(container), pix_fmt=container.pictures[deep])
         if not deep:
@@ -86,9 +88,10 @@ class Mux:
 
 
 def output_args(
-    path: str | Path, encoding: Encoding, container: Container | None = None
+    path: str | Path, encoding: Encoding, container: Container | None = None, delay: float = 0.0
 ) -> list[str]:
-    """The video encoder's and the container's arguments for an output ``path``."""
+    """The video encoder's and the container's arguments for an output ``path``, the
+    video started ``delay`` s late (:attr:`Mux.video_delay`)."""
     container = container or container_for(path)
     codec = encoding.codec_for(container)
     args = [*encoder_args(codec, encoding.crf, encoding.preset), "-pix_fmt", encoding.pix_fmt]
@@ -98,20 +101,22 @@ def output_args(
         args += ["-bf", "0"]
     if container.hevc_tag and codec in ("libx265", "hevc"):
         args += ["-tag:v", container.hevc_tag]
-    args += list(container.options)
+    args += list(container.options) + _filters(delay, container.video_filter)
     return [*args, "-f", container.muxer] if container.muxer else args
 
 
 DELAY_CLOCK = 90_000  # ticks per second of a delayed video's timestamps (MPEG's clock)
 
 
-def _delayed(delay: float) -> list[str]:
-    """Arguments that start the piped video ``delay`` s late, on a 90 kHz clock: the
-    pipe's own clock ticks in whole frames, which would round a 21 ms delay to 33."""
+def _filters(delay: float, chain: str) -> list[str]:
+    """The video's one filter graph: ``chain`` (the container's), after a shift that
+    starts the piped video ``delay`` s late, on a 90 kHz clock: the pipe's own clock
+    ticks in whole frames, which would round a 21 ms delay to 33."""
     if abs(delay) <= 5e-4:
-        return []
+        return ["-filter:v", chain] if chain else []
     shift = f"settb=1/{DELAY_CLOCK},setpts=PTS+{delay:.6f}/TB"
-    return ["-filter:v", shift, "-enc_time_base:v", f"1:{DELAY_CLOCK}"]
+    graph = f"{shift},{chain}" if chain else shift
+    return ["-filter:v", graph, "-enc_time_base:v", f"1:{DELAY_CLOCK}"]
 
 
 class FrameWriter:
@@ -147,10 +152,10 @@ class FrameWriter:
         for extra in mux.inputs:
             cmd += list(extra)
         # the video is the track players show: Matroska otherwise marks it not the default
-        cmd += ["-map", "0:v", "-disposition:v:0", "default", *mux.args, *_delayed(mux.video_delay)]
+        cmd += ["-map", "0:v", "-disposition:v:0", "default", *mux.args]
         container = container or container_for(path)
         codec = encoding.codec_for(container)
-        cmd += [*output_args(path, encoding, container), *colour.ffmpeg_args()]
+        cmd += [*output_args(path, encoding, container, mux.video_delay), *colour.ffmpeg_args()]
         cmd += [*colour.hdr10_args(codec), local(path, container.pictures is not None)]
         self._process = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
         widen_pipe(self._process.stdin)

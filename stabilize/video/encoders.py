@@ -2,7 +2,8 @@
 
 x264 and x265 take both as they are. The others get their own scales: VP9 constant
 quality needs ``-b:v 0``, and its speed is ``-cpu-used``; SVT-AV1 numbers its presets;
-an image sequence's JPEG takes a quantiser, and its PNG or TIFF neither (lossless).
+an image sequence's JPEG takes a quantiser, and its PNG or TIFF neither (lossless); a GIF
+takes none (its palette is its quality).
 An encoder not listed gets ``-crf`` and ``-preset`` as they are, and the pre-flight check
 (:func:`stabilize.video.preflight.check_encoder`) refuses what it does not take.
 """
@@ -58,6 +59,10 @@ def _lossless(crf: int, preset: str) -> list[str]:
     return []  # PNG and TIFF keep every sample: no quality to choose
 
 
+def _gif(crf: int, preset: str) -> list[str]:
+    return []  # its palette is its quality (the container's filter): no scale to set
+
+
 # The registry: an encoder's name → its arguments for (crf, preset).
 ENCODERS: dict[str, Callable[[int, str], list[str]]] = {
     "libx264": _x26x,
@@ -68,6 +73,7 @@ ENCODERS: dict[str, Callable[[int, str], list[str]]] = {
     "mjpeg": _jpeg,
     "png": _lossless,
     "tiff": _lossless,
+    "gif": _gif,
 }
 
 

@@ -165,7 +165,7 @@ def test_hevc_in_mp4_is_tagged_hvc1(tmp_path):
 
 
 MUXERS = {".mp4": "mp4", ".m4v": "mp4", ".mov": "mov", ".mkv": "matroska", ".webm": "webm"}
-MUXERS |= {".avi": "avi", ".ts": "mpegts", ".unknown": ""}
+MUXERS |= {".avi": "avi", ".ts": "mpegts", ".gif": "gif", ".unknown": ""}
 
 
 @pytest.mark.parametrize(("suffix", "muxer"), list(MUXERS.items()))
@@ -270,3 +270,23 @@ def test_attached_files_are_kept_in_matroska_and_a_cover_is_said_left_out(attach
 def test_attached_files_no_container_but_matroska_holds_are_said_left_out(attached):
     mux = keep_streams(probe(attached), container_for("out.mp4"))
     assert "left out attachment #3 (font.ttf): MP4 cannot hold it" in mux.notices
+
+
+def test_a_gif_keeps_every_frame_and_its_time_and_loops(attached, tmp_path):
+    # "FFmpeg cannot write libx264 as .gif" before; the source here runs at a variable rate
+    out = tmp_path / "out.gif"
+    summary, _ = stabilize_video(attached, out, Settings(fov=70.0))
+    assert summary["encoder"] == {"codec": "gif", "pix_fmt": "pal8"}
+    assert sum("GIF cannot hold it" in n for n in summary["notices"]) == 3  # audio, ASS, font
+    times = frame_times(attached)
+    np.testing.assert_allclose(frame_times(out), times, atol=0.006)  # GIF's centiseconds
+    from PIL import Image
+
+    with Image.open(out) as gif:
+        assert gif.n_frames == 60 and gif.info["loop"] == 0  # for ever
+    # its palette of 256 colours a frame keeps the picture: as the MP4's, within a few levels
+    mp4 = tmp_path / "out.mp4"
+    stabilize_video(attached, mp4, Settings(fov=70.0, encoding=Encoding(crf=0)))
+    pairs = zip(read_frames(out), read_frames(mp4), strict=True)
+    gaps = [np.abs(a.astype(int) - b).mean() for a, b in pairs]
+    assert len(gaps) == 60 and max(gaps) < 4
