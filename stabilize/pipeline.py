@@ -132,6 +132,7 @@ def stabilize_video(
         "size": list(job.info.shown_framed_size[::-1]),  # as shown, its bars included
         # counter-clockwise, degrees: the report's axes and pixels are the stored frames'
         "display_rotation": job.info.rotation,
+        "display_mirror": job.info.mirror,
         "pixel_aspect": job.info.pixel_aspect,  # the input's; the output's pixels are square
         "bars": None if job.info.bars is None else list(job.info.bars),  # top, bottom, left, right
         "field_order": job.info.field_order or None,  # the input's: tff, bff, progressive

@@ -24,6 +24,7 @@ from stabilize.video.sequence import (
     is_pattern,
     sequence_args,
 )
+from stabilize.video.turn import display_transform
 
 
 class VideoError(ValueError):
@@ -83,6 +84,9 @@ class VideoInfo:
     # closed captions (EIA-608/708, a broadcast's) carried in the video's own frames,
     # which FFmpeg's listing names on the stream's line
     captions: bool = False
+    # whether the shown frames are the stored ones mirrored left to right, before the
+    # display rotation turns them: a display matrix with a flip (a front camera's)
+    mirror: bool = False
 
     @property
     def size(self) -> tuple[int, int]:
@@ -95,6 +99,12 @@ class VideoInfo:
         return 0 if self.autorotate else self.rotation // 90
 
     @property
+    def mirrored(self) -> bool:
+        """Whether the decoded frames are mirrored left to right (before :attr:`turns`)
+        to be shown: False unless the display rotation is left to the caller."""
+        return self.mirror and not self.autorotate
+
+    @property
     def shown_size(self) -> tuple[int, int]:
         """(H, W) of the frames as a player shows them."""
         return self.size[::-1] if self.turns % 2 else self.size
@@ -104,10 +114,10 @@ class VideoInfo:
         (FFmpeg's ``-noautorotate``) where it is a whole number of quarter turns. Its
         rows are then the sensor's rows, read out one after another under a rolling
         shutter, however the camera was held; :attr:`turns` turns them to be shown."""
-        if not self.autorotate or self.rotation not in (90, 180, 270):
+        if not self.autorotate or (self.rotation not in (90, 180, 270) and not self.mirror):
             return self
-        h, w = self.size[::-1] if self.rotation != 180 else self.size
-        coded = self.coded and (self.coded[::-1] if self.rotation != 180 else self.coded)
+        h, w = self.size[::-1] if self.rotation in (90, 270) else self.size
+        coded = self.coded and (self.coded[::-1] if self.rotation in (90, 270) else self.coded)
         return replace(self, width=w, height=h, autorotate=False, coded=coded)
 
     @property
@@ -256,8 +266,12 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     )
     rot = _ROTATION.search(text)
     rotation = int(round(float(rot.group(1) or rot.group(2)))) % 360 if rot else 0
+    mirror = False
     if pattern and not rot:  # an image's EXIF orientation, which FFmpeg does not list
         rotation = exif_rotation(path, first)
+    elif rot and (shown := display_transform(path, (h, w), input_args)):
+        # the listed rotation is not the turn where the matrix also flips the frame
+        rotation, mirror = 90 * shown[0], shown[1]
     sar = _SAR.search(stream_line)
     aspect = Fraction(int(sar.group(1)), int(sar.group(2))) if sar and int(sar.group(2)) else 0
     aspect = aspect or Fraction(1)  # none, or 0:1 ("unknown"): square
@@ -294,4 +308,5 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
         pixel_aspect=f"{aspect.numerator}:{aspect.denominator}",
         coded=coded,
         captions="Closed Captions" in stream_line,
+        mirror=mirror,
     )

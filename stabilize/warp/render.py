@@ -67,7 +67,7 @@ def render(
         turned to be shown, then at the output's size."""
         if info.bars:
             frame = put_back(frame, info.bars, planar, info.colour.full_range)
-        frame = turn(frame, info.turns, planar)
+        frame = turn(frame, info.turns, planar, info.mirrored)
         if settings.size:
             return resize(frame, (h, w))
         if (h, w) != info.shown_framed_size:  # odd sides: one row or column off the edge
