@@ -50,7 +50,7 @@ from stabilize.video.binary import local
 from stabilize.video.colour import DOLBY_BASE
 from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Encoding, Mux
-from stabilize.video.fields import DEINTERLACE_MODES
+from stabilize.video.fields import DEINTERLACE_MODES, field_times
 from stabilize.video.i420 import chroma, has_alpha
 from stabilize.video.preflight import check_encoder, check_writable, describe
 from stabilize.video.sequence import first_image, sequence_args
@@ -187,6 +187,9 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
 
         first = first_stamp(first_image(info.input_args))
         stamps = sensor_frame_times(settings.gyro_timestamps, first, len(times))
+    if info.fields:  # a frame for each field, each at its own time
+        times = field_times(times)
+        stamps = None if stamps is None else field_times(stamps)
     # Last, once every check has passed (it decodes frames): the picture inside black
     # bars baked into the frame. A lens's frame is the sensor's, bars or not.
     if settings.bars == "auto" and not settings.lens:
@@ -265,9 +268,16 @@ def dolby_vision_notice(profile: str | None) -> tuple[str, ...]:
 
 
 def fields_notice(info: VideoInfo) -> tuple[str, ...]:
-    """A notice where the frames are deinterlaced, or where an interlaced stream is not
-    (``--deinterlace off``: the warp then blends its fields into combs)."""
+    """A notice where the frames are deinterlaced (each field into a frame of its own,
+    with ``--deinterlace fields``), or where an interlaced stream is not (``--deinterlace
+    off``: the warp then blends its fields into combs)."""
     order = {"tff": "top field first", "bff": "bottom field first"}.get(info.field_order)
+    if info.fields:
+        what = f"interlaced ({order})" if order else "flagged progressive"
+        return (
+            f"{what}: each field deinterlaced into a frame of its own (FFmpeg's bwdif), "
+            f"{info.fps / 2:g} → {info.fps:g} frames a second; the output is progressive",
+        )
     if info.deinterlace:
         what = f"interlaced ({order})" if order else "flagged progressive"
         return (f"{what}: each frame deinterlaced (FFmpeg's bwdif); the output is progressive",)

@@ -102,7 +102,8 @@ DeinterlaceOption = Annotated[
     Literal[DEINTERLACE_MODES],
     typer.Option(
         help="Interlaced video (a camcorder's 50i, 60i): auto deinterlaces a stream flagged "
-        "interlaced, on every stream (one flagged progressive but combed), off none."
+        "interlaced, on every stream (one flagged progressive but combed), off none; fields "
+        "makes each field a frame of its own (50i → 50p, as a television shows it)."
     ),
 ]
 BarsOption = Annotated[

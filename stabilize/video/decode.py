@@ -65,7 +65,8 @@ def read_frames(
         for name, value in TURN_FILTERS[info.rotation]:
             stream = stream.filter(name, value) if value else stream.filter(name)
     if info.deinterlace:  # before any scaling, which would blend the fields
-        name, fields = deinterlace_filter(every_frame=not interlaced(info.field_order))
+        every = not interlaced(info.field_order)
+        name, fields = deinterlace_filter(every_frame=every, fields=info.fields)
         stream = stream.filter(name, **fields)
     source = (dh, dw)
     if info.bars:  # the picture inside them, in square pixels

@@ -9,11 +9,18 @@ them: on a rendered 50i street clip shaken 1.5°, the combing the warp left read
 deinterlaced on decoding, by FFmpeg's ``bwdif`` (Bob Weaver: each missing row
 interpolated in space and in time, with yadif's checks against false motion), one frame
 for each frame: every frame and its time stay as they were, and the output is progressive.
+
+``--deinterlace fields`` makes each field a frame of its own instead (50i → 50p, what a
+television shows): twice the frames, each at its field's time, half a frame interval
+apart, so the motion runs as smoothly as it was filmed.
 """
 
 from __future__ import annotations
 
 import re
+
+import numpy as np
+from numpy.typing import NDArray
 
 # What ``ffmpeg -i`` prints, in the parentheses after the pixel format, for each field
 # order (libavcodec's av_field_order names), and ours: tff and bff are top and bottom
@@ -26,7 +33,7 @@ _FFMPEG_NAMES = {
     "top coded first (swapped)": "tff",
     "bottom coded first (swapped)": "bff",
 }
-DEINTERLACE_MODES = ("auto", "on", "off")
+DEINTERLACE_MODES = ("auto", "on", "off", "fields")
 
 
 def field_order(details: str) -> str:
@@ -65,13 +72,27 @@ def interlaced(order: str) -> bool:
     return order in ("tff", "bff")
 
 
-def deinterlace_filter(every_frame: bool) -> tuple[str, dict[str, str]]:
+def deinterlace_filter(every_frame: bool, fields: bool = False) -> tuple[str, dict[str, str]]:
     """FFmpeg's filter and options: ``bwdif``, a frame out for each frame in
-    (``send_frame``), the parity from each frame's flags. ``every_frame`` deinterlaces
-    every frame, as a stream flagged progressive but combed needs; otherwise only the
-    frames flagged interlaced (a stream may mix them)."""
+    (``send_frame``), or for each field (``fields``: every frame, two out for each), the
+    parity from each frame's flags. ``every_frame`` deinterlaces every frame, as a stream
+    flagged progressive but combed needs; otherwise only the frames flagged interlaced (a
+    stream may mix them)."""
     return "bwdif", {
-        "mode": "send_frame",
+        "mode": "send_field" if fields else "send_frame",
         "parity": "auto",
-        "deint": "all" if every_frame else "interlaced",
+        "deint": "all" if every_frame or fields else "interlaced",
     }
+
+
+def field_times(times: NDArray) -> NDArray[np.float64]:
+    """The times of the fields of frames at ``times`` (s): each frame's, and half way to
+    the next (the last frame's second field half the median interval after it).
+
+    >>> field_times(np.array([0.0, 0.04, 0.08])).round(3).tolist()
+    [0.0, 0.02, 0.04, 0.06, 0.08, 0.1]
+    """
+    times = np.asarray(times, dtype=np.float64)
+    step = np.diff(times)
+    last = float(np.median(step)) if len(step) else 0.04
+    return np.column_stack([times, times + np.append(step, last) / 2]).ravel()

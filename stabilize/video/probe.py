@@ -71,6 +71,7 @@ class VideoInfo:
     autorotate: bool = True  # whether FFmpeg turns the frames by the display rotation
     field_order: str = ""  # "progressive", "tff", "bff", or "" where FFmpeg names none
     deinterlace: bool = False  # whether frames are deinterlaced on decoding (bwdif)
+    fields: bool = False  # whether each field is decoded as a frame (twice the frames, at fps)
     # An anamorphic stream's sample aspect ratio (its pixels' width over their height, as
     # "4:3"), and (H, W) of its frames as FFmpeg decodes them, before they are resampled
     # to square pixels; None where the pixels are square
@@ -160,9 +161,12 @@ class VideoInfo:
         """The video as it will be decoded under ``--deinterlace`` ``mode``
         (:mod:`stabilize.video.fields`): ``auto`` deinterlaces a stream whose field order
         says it is interlaced (what :func:`probe` sets), ``on`` every stream (one flagged
-        progressive but combed), ``off`` none."""
+        progressive but combed), ``off`` none, ``fields`` every stream, each field into a
+        frame of its own (twice the frames, at twice the rate)."""
         if mode not in DEINTERLACE_MODES:
             raise ValueError(f"--deinterlace must be one of {', '.join(DEINTERLACE_MODES)}")
+        if mode == "fields":  # at twice the frame rate
+            return replace(self, deinterlace=True, fields=True, fps=2 * self.fps)
         every = {"auto": interlaced(self.field_order), "on": True, "off": False}[mode]
         return replace(self, deinterlace=every)
 
