@@ -48,7 +48,7 @@ def read_frames(
     options = {k.lstrip("-"): v for k, v in zip(args[::2], args[1::2], strict=True)}
     # An image sequence's EXIF orientation is turned here, the same on every FFmpeg: some
     # versions turn it (9.0 does, frame by frame), others leave it
-    exif_turn = info.autorotate and info.rotation and is_pattern(path)
+    exif_turn = info.autorotate and (info.rotation or info.mirror) and is_pattern(path)
     if not info.autorotate or exif_turn:
         options["noautorotate"] = None
     dh, dw = info.decoded_size
@@ -62,7 +62,8 @@ def read_frames(
     # a dashcam's front camera after its smaller rear one was read at the rear's size
     stream = ffmpeg.input(local(path, "image2" in args), **options)["v:0"]
     if exif_turn:
-        for name, value in TURN_FILTERS[info.rotation]:
+        mirror = (("hflip", None),) if info.mirror else ()
+        for name, value in (*mirror, *TURN_FILTERS.get(info.rotation, ())):
             stream = stream.filter(name, value) if value else stream.filter(name)
     if info.deinterlace:  # before any scaling, which would blend the fields
         every = not interlaced(info.field_order)

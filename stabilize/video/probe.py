@@ -18,7 +18,7 @@ from stabilize.video.fields import DEINTERLACE_MODES, field_order, frame_field_o
 from stabilize.video.first_frame import first_frame_report
 from stabilize.video.i420 import pipe_format
 from stabilize.video.sequence import (
-    exif_rotation,
+    exif_orientation,
     first_image,
     gap_message,
     is_pattern,
@@ -272,7 +272,7 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     rotation = int(round(float(rot.group(1) or rot.group(2)))) % 360 if rot else 0
     mirror = False
     if pattern and not rot:  # an image's EXIF orientation, which FFmpeg does not list
-        rotation = exif_rotation(path, first)
+        rotation, mirror = exif_orientation(path, first)
     elif rot and (shown := display_transform(path, (h, w), input_args)):
         # the listed rotation is not the turn where the matrix also flips the frame
         rotation, mirror = 90 * shown[0], shown[1]

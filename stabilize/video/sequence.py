@@ -83,23 +83,27 @@ def first_number(pattern: str | Path) -> int | None:
     return min(sequence_files(pattern), default=None)
 
 
-# EXIF's Orientation (tag 274) → the display rotation, degrees counter-clockwise, as
-# FFmpeg gives a video's: 6, "turn 90° clockwise to show", is a phone held upright.
-# The mirrored orientations (2, 4, 5, 7) come from no camera and are left as stored.
-EXIF_ROTATION = {1: 0, 3: 180, 6: 270, 8: 90}
+# EXIF's Orientation (tag 274) → (the display rotation, degrees counter-clockwise, as
+# FFmpeg gives a video's; whether the stored picture is mirrored left to right before it
+# turns): 6, "turn 90° clockwise to show", is a phone held upright; the mirrored ones
+# (2, 4, 5, 7) are a front camera's photos saved as its preview showed them
+EXIF_ORIENTATION = {
+    1: (0, False), 2: (0, True), 3: (180, False), 4: (180, True),
+    5: (90, True), 6: (270, False), 7: (270, True), 8: (90, False),
+}  # fmt: skip
 
 
-def exif_rotation(pattern: str | Path, number: int) -> int:
-    """The display rotation that image ``number``'s EXIF Orientation asks for, which
-    FFmpeg's listing of an image sequence does not give: a phone's photos held upright
-    are stored sideways, with orientation 6. 0 where it says none."""
+def exif_orientation(pattern: str | Path, number: int) -> tuple[int, bool]:
+    """(display rotation, mirror) that image ``number``'s EXIF Orientation asks for,
+    which FFmpeg's listing of an image sequence does not give: a phone's photos held
+    upright are stored sideways, with orientation 6. (0, False) where it says none."""
     try:
         from PIL import Image
 
         with Image.open(picture(pattern, number)) as image:
-            return EXIF_ROTATION.get(int(image.getexif().get(0x0112, 1)), 0)
+            return EXIF_ORIENTATION.get(int(image.getexif().get(0x0112, 1)), (0, False))
     except (OSError, ValueError, ImportError):
-        return 0
+        return 0, False
 
 
 def gap_message(pattern: str | Path, start: int) -> str | None:

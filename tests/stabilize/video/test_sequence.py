@@ -126,3 +126,28 @@ def test_a_percent_in_a_folders_or_files_name_is_not_a_frame_number(shaky, tmp_p
     summary, _ = stabilize_video(source, out, Settings())  # --fov auto reads its EXIF
     assert sorted(sequence_files(out)) == list(range(1, 13)) and summary["frames"] == 12
     assert len(list(read_frames(out))) == 12
+
+
+@pytest.mark.parametrize("orientation", range(1, 9))
+def test_every_exif_orientation_is_shown_as_photo_viewers_show_it(tmp_path, orientation):
+    # the mirrored ones (2, 4, 5, 7: a front camera's, saved as its preview showed it)
+    # were left as stored
+    from PIL import Image, ImageOps
+
+    from stabilize.video.turn import turn
+
+    rng = np.random.default_rng(orientation)
+    stored = rng.integers(0, 256, (3, 48, 64, 3), dtype=np.uint8)  # no symmetry to hide in
+    for number, frame in enumerate(stored, start=1):
+        photo = Image.fromarray(frame)
+        exif = photo.getexif()
+        exif[0x0112] = orientation
+        photo.save(tmp_path / f"p{number}.png", exif=exif.tobytes())
+    with Image.open(tmp_path / "p1.png") as first:
+        viewed = np.asarray(ImageOps.exif_transpose(first).convert("RGB"))
+    pattern = tmp_path / "p%d.png"
+    info = probe(pattern)
+    raw = info.stored()
+    np.testing.assert_array_equal(next(read_frames(pattern, info=raw)), stored[0])
+    np.testing.assert_array_equal(turn(stored[0], raw.turns, mirror=raw.mirrored), viewed)
+    np.testing.assert_array_equal(next(read_frames(pattern, info=info)), viewed)
