@@ -203,6 +203,12 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
             notices += ("an image sequence keeps no frame times (--report's path.csv has them)",)
     notices += encoder_notice(encoding, settings.encoding.codec_for(container))
     notices += dolby_vision_notice(info.colour.dolby_vision)
+    if info.colour.hdr10_plus:
+        notices += (
+            "HDR10+ (its tone mapping for each frame, SMPTE 2094-40) left out: it does not "
+            "travel through the pipe; the HDR10 picture and its static metadata are kept, "
+            "and play as HDR10",
+        )
     if info.captions:
         notices += (
             "closed captions (EIA-608/708, carried in the video's frames) left out: they "

@@ -60,6 +60,9 @@ class Colour:
     # its per-frame metadata does not travel through the pipe, so only its base layer
     # (:data:`DOLBY_BASE`) is kept
     dolby_vision: str | None = None
+    # HDR10+ (SMPTE 2094-40: a Samsung phone's HDR video), whose per-frame tone mapping
+    # does not travel through the pipe either: its HDR10 base and static metadata are kept
+    hdr10_plus: bool = False
 
     @property
     def full_range(self) -> bool:
@@ -137,7 +140,8 @@ _LIGHT = re.compile(r"Content light level metadata: MaxCLL=(\d+), MaxFALL=(\d+)"
 
 def with_hdr10(colour: Colour, report: str) -> Colour:
     """``colour`` with the HDR10 metadata a first frame's ``showinfo`` report gives
-    (:func:`stabilize.video.first_frame.first_frame_report`), if any.
+    (:func:`stabilize.video.first_frame.first_frame_report`), if any, and whether it
+    carries HDR10+'s.
 
     >>> line = ("Mastering display metadata: has_primaries:1 has_luminance:1 "
     ...         "r(0.6800,0.3200) g(0.2650,0.6900) b(0.1500 0.0600) wp(0.3127, 0.3290) "
@@ -152,7 +156,8 @@ def with_hdr10(colour: Colour, report: str) -> Colour:
         low, high = (round(float(v) * 10000) for v in m.groups()[8:])
         mastering = f"G({gx},{gy})B({bx},{by})R({rx},{ry})WP({wx},{wy})L({high},{low})"
     cll = f"{light.group(1)},{light.group(2)}" if light else None
-    return replace(colour, mastering=mastering, light=cll)
+    plus = "SMPTE2094-40" in report
+    return replace(colour, mastering=mastering, light=cll, hdr10_plus=plus)
 
 
 def colour_of(pix_fmt: str, details: str) -> Colour:

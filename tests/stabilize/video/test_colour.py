@@ -131,6 +131,42 @@ def test_hdr10_metadata_an_encoder_cannot_write_is_said_lost(hdr10, tmp_path):
     assert any("HDR10's mastering display" in n for n in summary["notices"])
 
 
+# One scene of HDR10+ metadata, in the JSON x265 reads (Samsung's format)
+HDR10_PLUS = {
+    "JSONInfo": {"HDR10plusProfile": "A", "Version": "1.0"},
+    "SceneInfo": [{
+        "BezierCurveData": {"Anchors": [256, 512, 768, 1024, 1280, 1536, 1792, 2048, 2304],
+                            "KneePointX": 100, "KneePointY": 100},
+        "LuminanceParameters": {
+            "AverageRGB": 100, "MaxScl": [500, 500, 500],
+            "LuminanceDistributions": {"DistributionIndex": [1, 5, 10, 25, 50, 75, 90, 95, 99],
+                                       "DistributionValues": [1, 2, 3, 4, 5, 6, 7, 8, 9]},
+        },
+        "NumberOfWindows": 1, "TargetedSystemDisplayMaximumLuminance": 1000,
+        "SceneFrameIndex": 0, "SceneId": 0, "SequenceFrameIndex": 0,
+    }],
+    "SceneInfoSummary": {"SceneFirstFrameIndex": [0], "SceneFrameNumbers": [1]},
+    "ToolInfo": {"Tool": "test", "Version": "1"},
+}  # fmt: skip
+
+
+def test_hdr10_plus_left_out_is_said(shaky, tmp_path):
+    # a Samsung phone's HDR video: its tone mapping for each frame went silently
+    import json
+
+    (tmp_path / "plus.json").write_text(json.dumps(HDR10_PLUS))
+    clip = tmp_path / "plus.mp4"
+    x265 = (
+        f"hdr10=1:master-display={MASTERING}:log-level=error:dhdr10-info={tmp_path / 'plus.json'}"
+    )
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-t", "0.3", "-c:v", "libx265"]
+    cmd += ["-preset", "ultrafast", "-pix_fmt", "yuv420p10le", "-x265-params", x265]
+    subprocess.run([*cmd, "-an", str(clip)], check=True)
+    assert probe(clip).colour.hdr10_plus and not probe(shaky).colour.hdr10_plus
+    summary, _ = stabilize_video(clip, tmp_path / "out.mp4", Settings(fov=70.0))
+    assert any(n.startswith("HDR10+ (its tone mapping") for n in summary["notices"])
+
+
 @pytest.mark.parametrize(
     ("profile", "said"),
     [
