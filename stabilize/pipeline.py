@@ -51,7 +51,7 @@ from stabilize.video.colour import DOLBY_BASE
 from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Encoding, Mux
 from stabilize.video.fields import DEINTERLACE_MODES, field_times
-from stabilize.video.i420 import chroma, has_alpha
+from stabilize.video.i420 import chroma, has_alpha, pipe_format
 from stabilize.video.preflight import check_encoder, check_writable, describe
 from stabilize.video.sequence import first_image, sequence_args
 from stabilize.video.streams import keep_streams
@@ -219,7 +219,13 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
             f"the source's alpha (transparency, {info.pix_fmt}) is left out: the frames "
             "are stabilised and written without it",
         )
-    notices += chroma_notice(info.pix_fmt, piped_format(info, settings), encoding.pix_fmt)
+    piped = piped_format(info, settings)
+    notices += chroma_notice(info.pix_fmt, piped, encoding.pix_fmt)
+    if pipe_format(piped) != "yuv420p" and pipe_format(encoding.pix_fmt) == "yuv420p":
+        notices += (
+            f"{info.pix_fmt} video written at 8 bits: {encoding.codec} "
+            f"({encoding.pix_fmt}) holds no more",
+        )
     if info.colour.hdr10_lost(encoding.codec):
         notices += (
             f"HDR10's mastering display and light levels left out: {encoding.codec} does "

@@ -52,6 +52,9 @@ class Container:
     pix_fmt: str | None = None
     # FFmpeg filters the video passes before its encoder (GIF's palette)
     video_filter: str = ""
+    # Whether a delayed video's timestamps may tick on a 90 kHz clock: MPEG-PS's muxer
+    # wrote 24 MB of padding for 2 s of H.264 on one, taking minutes
+    fine_clock: bool = True
     # Attached files (the fonts an ASS subtitle track is drawn with), Matroska's alone
     attachments: bool = False
 
@@ -123,6 +126,18 @@ GIF_PALETTE = (
     "split[a][b];[a]palettegen=stats_mode=single[p];[b][p]paletteuse=new=1:dither=sierra2_4a"
 )
 
+MPEG_PS = Container(
+    "vob",
+    "mpeg2video",
+    audio=frozenset({"mp2", "mp3", "ac3", "pcm_dvd"}),
+    audio_encoder="mp2",
+    subtitles=frozenset({"dvd_subtitle"}),
+    chapters=False,
+    pix_fmt="yuv420p",
+    fine_clock=False,
+    name="MPEG-PS",
+)
+
 JPEG = image_sequence("mjpeg", ("yuvj420p", "yuvj420p"))  # full range, as JPEG files are
 TIFF = image_sequence("tiff", ("rgb24", "rgb48le"))
 
@@ -174,6 +189,10 @@ CONTAINERS: dict[str, Container] = {
     ".jpeg": JPEG,
     ".tif": TIFF,
     ".tiff": TIFF,
+    # a DVD camcorder's, a DVD's: MPEG-2 video at 8 bits, MPEG or AC-3 audio
+    ".mpg": MPEG_PS,
+    ".mpeg": MPEG_PS,
+    ".vob": MPEG_PS,
     ".gif": animation("gif", "gif", pix_fmt="pal8", video_filter=GIF_PALETTE, name="GIF"),
 }
 

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from stabilize.video.binary import ffmpeg_exe, local, widen_pipe
 from stabilize.video.colour import UNKNOWN, Colour
 from stabilize.video.containers import Container, container_for
-from stabilize.video.encoders import encoder_args
+from stabilize.video.encoders import FRAME_CLOCKED, encoder_args
 from stabilize.video.i420 import pipe_layout
 
 
@@ -101,22 +101,26 @@ def output_args(
         args += ["-bf", "0"]
     if container.hevc_tag and codec in ("libx265", "hevc"):
         args += ["-tag:v", container.hevc_tag]
-    args += list(container.options) + _filters(delay, container.video_filter)
+    fine = container.fine_clock and codec not in FRAME_CLOCKED
+    args += list(container.options) + _filters(delay, container.video_filter, fine)
     return [*args, "-f", container.muxer] if container.muxer else args
 
 
 DELAY_CLOCK = 90_000  # ticks per second of a delayed video's timestamps (MPEG's clock)
 
 
-def _filters(delay: float, chain: str) -> list[str]:
+def _filters(delay: float, chain: str, fine: bool = True) -> list[str]:
     """The video's one filter graph: ``chain`` (the container's), after a shift that
-    starts the piped video ``delay`` s late, on a 90 kHz clock: the pipe's own clock
-    ticks in whole frames, which would round a 21 ms delay to 33."""
+    starts the piped video ``delay`` s late, on a 90 kHz clock (``fine``): the pipe's own
+    clock ticks in whole frames, which would round a 21 ms delay to 33. Where the
+    encoder or the muxer cannot take that clock (``fine`` False), the delay is rounded
+    to whole frames."""
     if abs(delay) <= 5e-4:
         return ["-filter:v", chain] if chain else []
     shift = f"settb=1/{DELAY_CLOCK},setpts=PTS+{delay:.6f}/TB"
     graph = f"{shift},{chain}" if chain else shift
-    return ["-filter:v", graph, "-enc_time_base:v", f"1:{DELAY_CLOCK}"]
+    clock = ["-enc_time_base:v", f"1:{DELAY_CLOCK}"] if fine else []
+    return ["-filter:v", graph, *clock]
 
 
 class FrameWriter:

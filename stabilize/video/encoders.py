@@ -21,9 +21,12 @@ X264_PRESETS = (
 DEFAULT_CRF = {"libx264": 18, "libx265": 20, "libvpx-vp9": 31, "libsvtav1": 30, "libaom-av1": 30}
 # The encoders whose frames lean on one another: no picture file holds one alone
 VIDEO_ONLY = frozenset({"libx264", "libx265", "libvpx-vp9", "libsvtav1", "libaom-av1"})
-# JPEG's quantiser (-q:v, 1 best to 31) per step of x264's CRF: 18 gives 2, the usual
-# choice for frames kept for analysis
+# JPEG's and MPEG-2's quantiser (-q:v, 1 best to 31) per step of x264's CRF: 18 gives 2,
+# the usual choice for frames kept for analysis, and a DVD's best
 CRF_PER_JPEG_Q = 9
+# Encoders whose time base must be a frame rate their standard lists: a 90 kHz clock
+# (a delayed video's, :func:`stabilize.video.encode.output_args`) does not open them
+FRAME_CLOCKED = frozenset({"mpeg1video", "mpeg2video"})
 
 
 def _speed(preset: str, slowest: int, fastest: int) -> int:
@@ -71,6 +74,8 @@ ENCODERS: dict[str, Callable[[int, str], list[str]]] = {
     "libsvtav1": _svtav1,
     "libaom-av1": _aom,
     "mjpeg": _jpeg,
+    "mpeg2video": _jpeg,  # a quantiser, as JPEG's: MPEG-2 has no constant quality
+    "mpeg1video": _jpeg,
     "png": _lossless,
     "tiff": _lossless,
     "gif": _gif,

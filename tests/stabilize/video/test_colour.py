@@ -126,6 +126,16 @@ def test_hdr10_metadata_is_read_and_written_again(hdr10, tmp_path, codec):
     assert not any("HDR10" in n for n in summary["notices"])
 
 
+def test_a_deep_source_written_at_8_bits_is_said(hdr10, tmp_path):
+    # MPEG-2 (a DVD's) holds 8 bits: the two lost went silently
+    summary, _ = stabilize_video(hdr10, tmp_path / "out.mpg", Settings(fov=70.0))
+    assert probe(tmp_path / "out.mpg").pix_fmt == "yuv420p"
+    assert (
+        "yuv420p10le video written at 8 bits: mpeg2video (yuv420p) holds no more"
+        in (summary["notices"])
+    )
+
+
 def test_hdr10_metadata_an_encoder_cannot_write_is_said_lost(hdr10, tmp_path):
     summary, _ = stabilize_video(hdr10, tmp_path / "out.webm", Settings(fov=70.0))
     assert any("HDR10's mastering display" in n for n in summary["notices"])

@@ -165,7 +165,8 @@ def test_hevc_in_mp4_is_tagged_hvc1(tmp_path):
 
 
 MUXERS = {".mp4": "mp4", ".m4v": "mp4", ".mov": "mov", ".mkv": "matroska", ".webm": "webm"}
-MUXERS |= {".avi": "avi", ".ts": "mpegts", ".gif": "gif", ".unknown": ""}
+MUXERS |= {".avi": "avi", ".ts": "mpegts", ".gif": "gif", ".mpg": "vob", ".vob": "vob"}
+MUXERS |= {".unknown": ""}
 
 
 @pytest.mark.parametrize(("suffix", "muxer"), list(MUXERS.items()))

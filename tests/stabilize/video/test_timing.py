@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from stabilize import Settings, stabilize_video
-from stabilize.video import ffmpeg_exe, frame_times, probe, read_frames
+from stabilize.video import Encoding, ffmpeg_exe, frame_times, probe, read_frames
 from stabilize.video.retime import is_variable_rate
 
 
@@ -84,3 +84,17 @@ def test_a_clip_trimmed_without_re_encoding_keeps_the_frames_it_shows(shaky, tmp
     assert summary["frames"] == 45 and probe(out).has_audio
     np.testing.assert_allclose(frame_times(out), times, atol=1e-3)
     assert av_offset(out) == pytest.approx(av_offset(trimmed), abs=1e-3)
+
+
+@pytest.mark.parametrize(("suffix", "codec"), [(".mpg", None), (".mkv", "mpeg2video")])
+def test_mpeg2_and_mpeg_ps_take_a_late_video_within_a_frame(late_video, tmp_path, suffix, codec):
+    # MPEG-2's encoder opens on no 90 kHz clock (its delay's, before: "MPEG-1/2 does not
+    # support 90000/1 fps", after all the work), and MPEG-PS's muxer padded H.264 on one
+    # to 24 MB for 2 s, for minutes; .mpg was H.264, which no DVD player reads
+    out = tmp_path / f"out{suffix}"
+    settings = Settings(fov=70.0, encoding=Encoding(codec=codec))
+    summary, _ = stabilize_video(late_video, out, settings)
+    assert probe(out).codec == "mpeg2video" and summary["frames"] == 60
+    assert out.stat().st_size < 2_000_000  # 2 s of 640×360 at quantiser 2: about 0.8 MB
+    assert abs(av_offset(out) - av_offset(late_video)) < 1 / 60  # to the nearer frame
+    np.testing.assert_allclose(frame_times(out), frame_times(late_video), atol=1 / 60)
