@@ -44,7 +44,7 @@ from stabilize.path.zoom import CROP_MODES
 from stabilize.progress import ProgressFactory, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoInfo, atomic_output, frame_interval, frame_times, probe
-from stabilize.video.atomic import check_absent
+from stabilize.video.atomic import check_absent, is_sequence
 from stabilize.video.bars import BARS_MODES, detect_bars
 from stabilize.video.binary import local
 from stabilize.video.colour import DOLBY_BASE
@@ -53,7 +53,13 @@ from stabilize.video.encode import EncodeError, Encoding, Mux
 from stabilize.video.fields import DEINTERLACE_MODES, field_times
 from stabilize.video.i420 import chroma, has_alpha, pipe_format
 from stabilize.video.preflight import check_encoder, check_writable, describe
-from stabilize.video.sequence import first_image, sequence_args
+from stabilize.video.sequence import (
+    first_image,
+    is_pattern,
+    picture,
+    sequence_args,
+    sequence_files,
+)
 from stabilize.video.streams import keep_streams
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.lens import Lens, read_lens_profile
@@ -502,13 +508,23 @@ def settings_summary(settings: Settings) -> dict:
 
 
 def _check_output(src: Path, dst: Path, overwrite: bool) -> None:
-    """Refuse an output that is the input, or that exists without ``overwrite``."""
+    """Refuse an output that is the input, that would replace any of the input's
+    pictures, or that exists without ``overwrite``."""
     # an image sequence's pattern names no one file
     same = src.resolve() == dst.resolve() or (
         dst.exists() and src.exists() and os.path.samefile(src, dst)
     )
     if same:
         raise ValueError(f"the output {dst} is the input; choose another name")
+    if is_sequence(dst) and is_pattern(src):  # pictures beside pictures: none may be lost
+        inputs = {p.resolve() for p in sequence_files(src).values()}
+        replaced = {p.resolve() for p in sequence_files(dst).values()}  # with --overwrite
+        replaced |= {picture(dst, n).resolve() for n in sequence_files(src)}  # its numbers
+        if clash := sorted(inputs & replaced):
+            raise ValueError(
+                f"the output {dst} would replace the input's pictures ({clash[0].name}"
+                f"{' and others' if len(clash) > 1 else ''}); choose another name or folder"
+            )
     check_absent(dst, overwrite)
 
 

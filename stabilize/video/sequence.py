@@ -59,7 +59,7 @@ def picture(pattern: str | Path, number: int) -> Path:
     if number_at is None:
         return path
     head, tail = path.name[: number_at.start()], path.name[number_at.end() :]
-    return path.with_name(head + number_at.group() % number + tail)
+    return path.with_name(head + _digits(number_at, number) + tail)
 
 
 def sequence_files(pattern: str | Path) -> dict[int, Path]:
@@ -69,11 +69,27 @@ def sequence_files(pattern: str | Path) -> dict[int, Path]:
     {}
     """
     path = Path(pattern)
-    name = re.compile(_NUMBER.sub(r"(\\d+)", re.escape(path.name), count=1) + "$")
-    if not path.parent.is_dir():
+    spec = _NUMBER.search(path.name)
+    if spec is None or not path.parent.is_dir():
         return {}
+    head, tail = path.name[: spec.start()], path.name[spec.end() :]
+    name = re.compile(re.escape(head) + r"(\d+)" + re.escape(tail) + "$")
     found = ((name.match(p.name), p) for p in path.parent.iterdir())
-    return {int(m.group(1)): p for m, p in found if m}
+    # only the digits FFmpeg writes for the number: a looser match took 0001.png for a
+    # picture of %03d.png, which an output's --overwrite then deleted
+    return {
+        int(m.group(1)): p for m, p in found if m and _digits(spec, int(m.group(1))) == m.group(1)
+    }
+
+
+def _digits(spec: re.Match, number: int) -> str:
+    """The digits FFmpeg names picture ``number`` with in a pattern's ``spec``: padded
+    with zeros to its width, a space's flag or not (``%4d`` too: 0001, not C's "   1").
+
+    >>> [_digits(_NUMBER.search(s), 7) for s in ("%d", "%03d", "%4d")]
+    ['7', '007', '0007']
+    """
+    return str(number).zfill(int(spec.group()[1:-1] or 0))
 
 
 def first_number(pattern: str | Path) -> int | None:

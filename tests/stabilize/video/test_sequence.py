@@ -151,3 +151,31 @@ def test_every_exif_orientation_is_shown_as_photo_viewers_show_it(tmp_path, orie
     np.testing.assert_array_equal(next(read_frames(pattern, info=raw)), stored[0])
     np.testing.assert_array_equal(turn(stored[0], raw.turns, mirror=raw.mirrored), viewed)
     np.testing.assert_array_equal(next(read_frames(pattern, info=info)), viewed)
+
+
+def test_a_pattern_names_only_the_pictures_ffmpeg_names_so(tmp_path):
+    for name in ("0001.png", "001.png", "1.png", "10000.png"):
+        (tmp_path / name).write_bytes(b"")
+    found = {spec: sorted(p.name for p in sequence_files(tmp_path / f"{spec}.png").values())
+             for spec in ("%04d", "%4d", "%03d", "%d")}  # fmt: skip
+    # FFmpeg pads %4d with zeros too, where C's printf pads it with spaces
+    assert found == {
+        "%04d": ["0001.png", "10000.png"],
+        "%4d": ["0001.png", "10000.png"],
+        "%03d": ["001.png", "10000.png"],
+        "%d": ["1.png", "10000.png"],
+    }
+
+
+def test_the_inputs_pictures_are_never_replaced(shaky, tmp_path):
+    # %03d's --overwrite deleted the input's 0001.png…, and %4d's pictures, which FFmpeg
+    # names 0001.png…, were written over them
+    source = tmp_path / "%04d.png"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-frames:v", "8", str(source)]
+    subprocess.run(cmd, check=True)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    stabilize_video(source, tmp_path / "%03d.png", Settings(fov=70.0), overwrite=True)
+    with pytest.raises(ValueError, match=r"would replace the input's pictures \(0001.png and"):
+        stabilize_video(source, tmp_path / "%4d.png", Settings(fov=70.0), overwrite=True)
+    assert {name: (tmp_path / name).read_bytes() for name in before} == before
+    assert len(sequence_files(tmp_path / "%03d.png")) == 8
