@@ -139,6 +139,11 @@ def _jobs(params: dict, settings) -> list:
         run_or_fail(lambda: check_encoder(Path(f"check{suffix}"), settings.encoding, (64, 64)))
     gyro_auto = params["gyro"] == "auto"
     in_dir, out_dir = params["in_dir"], params["out_dir"]
+    inside = Path(in_dir).resolve()
+    if Path(out_dir).resolve() in (inside, *inside.parents):
+        # every clip under the output folder is taken for an output and skipped: this
+        # read "no files match" before
+        fail(f"{out_dir}: the output folder holds the input folder {in_dir}: choose one outside it")
     jobs = find_jobs(in_dir, out_dir, pattern, params["recursive"], gyro_auto, suffix)
     if not jobs:
         fail(f"{in_dir}: no files match {pattern!r}")

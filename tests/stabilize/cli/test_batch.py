@@ -15,6 +15,15 @@ def test_batch_errors():
     assert result.exit_code != 0 and "not a folder" in result.output
 
 
+def test_an_output_folder_holding_the_input_folder_is_refused(tmp_path):
+    # every clip under it was taken for an output and skipped: "no files match '*'"
+    (tmp_path / "in" / "sub").mkdir(parents=True)
+    (tmp_path / "in" / "sub" / "a.mp4").write_bytes(SAMPLE.read_bytes())
+    for src, out in (("in", "in"), ("in/sub", "in")):
+        result = CliRunner().invoke(app, ["batch", str(tmp_path / src), str(tmp_path / out)])
+        assert result.exit_code == 2 and "the output folder holds the input folder" in result.output
+
+
 def test_batch_takes_every_option_of_the_single_file_command():
     commands = typer.main.get_command(app).commands
     names = {name: {p.name for p in commands[name].params} for name in ("run", "batch")}
