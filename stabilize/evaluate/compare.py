@@ -40,6 +40,7 @@ from stabilize.motion.track import VisualTrack
 from stabilize.progress import ProgressFactory, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoInfo
+from stabilize.video.atomic import atomic_folder
 from stabilize.warp.lens import Lens
 
 MAX_ERROR_SHARE = 1.0  # AAE over the mean rotation per frame: the estimate says nothing
@@ -186,11 +187,17 @@ def compare_video(
 
 
 def write_comparison(folder: str | Path, result: Comparison) -> None:
-    """pairs.csv, summary.json and the plots rates.png, error.png, histogram.png."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
+    """pairs.csv, summary.json and the plots rates.png, error.png, histogram.png: all
+    from this run, or, where it fails, the old ones kept."""
+    with atomic_folder(folder) as tmp:
+        _write_pairs(tmp / "pairs.csv", result)
+        (tmp / "summary.json").write_text(json.dumps(result.summary(), indent=2))
+        plot_comparison(tmp, result)
+
+
+def _write_pairs(path: Path, result: Comparison) -> None:
     rv, rg = so3.log_so3(result.visual), so3.log_so3(result.gyro)
-    with open(folder / "pairs.csv", "w", newline="") as f:
+    with open(path, "w", newline="") as f:
         writer = csv.writer(f)
         writer.writerow(
             [
@@ -215,8 +222,6 @@ def write_comparison(folder: str | Path, result: Comparison) -> None:
                     f"{result.errors_deg[k]:.6f}",
                 ]
             )
-    (folder / "summary.json").write_text(json.dumps(result.summary(), indent=2))
-    plot_comparison(folder, result)
 
 
 def plot_comparison(folder: Path, result: Comparison) -> None:

@@ -11,6 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from rotation import so3
 from stabilize.motion.files import write_rotations
+from stabilize.video.atomic import atomic_folder
 from stabilize.warp.camera_path import CameraPath
 
 
@@ -78,10 +79,9 @@ def plot_trajectory(path: Path, planned: CameraPath) -> None:
 
 def write_report(folder: str | Path, planned: CameraPath, summary: dict) -> None:
     """The run's report folder: rotations.csv, path.csv, trajectory.png, summary.json."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    rotvecs = so3.log_so3(planned.rotations)
-    write_rotations(folder / "rotations.csv", planned.times[:-1], rotvecs, planned.support)
-    write_path(folder / "path.csv", planned)
-    plot_trajectory(folder / "trajectory.png", planned)
-    (folder / "summary.json").write_text(json.dumps(summary, indent=2))
+    with atomic_folder(folder) as tmp:  # all four from this run, or the old ones kept
+        rotvecs = so3.log_so3(planned.rotations)
+        write_rotations(tmp / "rotations.csv", planned.times[:-1], rotvecs, planned.support)
+        write_path(tmp / "path.csv", planned)
+        plot_trajectory(tmp / "trajectory.png", planned)
+        (tmp / "summary.json").write_text(json.dumps(summary, indent=2))

@@ -71,24 +71,47 @@ def atomic_output(path: str | os.PathLike, *, overwrite: bool = False) -> Iterat
 
 
 @contextlib.contextmanager
+def atomic_folder(folder: str | os.PathLike) -> Iterator[Path]:
+    """A temporary folder beside ``folder`` (made if missing), whose files are moved into
+    it, each replacing its namesake, only if the block succeeds: a report's files all
+    come from one run, and a failed run leaves the old ones as they were."""
+    final = Path(folder).resolve()
+    final.mkdir(parents=True, exist_ok=True)
+    with _staging(final.parent, final.name) as tmp:
+        yield tmp
+        _move_in(tmp, final)
+
+
+@contextlib.contextmanager
 def _atomic_sequence(final: Path) -> Iterator[Path]:
     # FFmpeg reads a % anywhere in the path as the frame number's place
-    stem = final.stem.replace("%", "")
-    sweep_stale(final.parent, f".{stem}.*.partial")
-    folder = Path(
-        tempfile.mkdtemp(prefix=f".{stem}.{os.getpid()}.", suffix=".partial", dir=final.parent)
-    )
-    try:
-        yield folder / final.name
-        umask = os.umask(0)
-        os.umask(umask)
+    with _staging(final.parent, final.stem.replace("%", "")) as tmp:
+        yield tmp / final.name
         for old in sequence_files(final).values():
             old.unlink()
-        for picture in sorted(folder.iterdir()):
-            os.chmod(picture, 0o666 & ~umask)
-            os.replace(picture, final.parent / picture.name)
+        _move_in(tmp, final.parent)
+
+
+@contextlib.contextmanager
+def _staging(parent: Path, stem: str) -> Iterator[Path]:
+    """A hidden temporary folder in ``parent`` (``.STEM.PID.RANDOM.partial``, so that a
+    killed run's is swept by the next), removed after the block."""
+    sweep_stale(parent, f".{stem}.*.partial")
+    tmp = Path(tempfile.mkdtemp(prefix=f".{stem}.{os.getpid()}.", suffix=".partial", dir=parent))
+    try:
+        yield tmp
     finally:
-        shutil.rmtree(folder, ignore_errors=True)
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _move_in(tmp: Path, dest: Path) -> None:
+    """Every file made in ``tmp`` moved into ``dest``, each replacing its namesake, with
+    the permissions outputs get (mkstemp makes files private)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    for made in sorted(tmp.iterdir()):
+        os.chmod(made, 0o666 & ~umask)
+        os.replace(made, dest / made.name)
 
 
 _OWNER = re.compile(r"\.(\d+)\.[^.]+\.partial")  # the pid in .NAME.PID.RANDOM.partial.SUFFIX

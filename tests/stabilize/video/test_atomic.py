@@ -67,3 +67,21 @@ def test_a_failed_image_sequence_leaves_the_old_one(tmp_path):
         (tmp.parent / "f1.png").write_bytes(b"half")
         raise RuntimeError("encoder died")
     assert [p.name for p in tmp_path.iterdir()] == ["f1.png"] and old.read_bytes() == b"old"
+
+
+def test_a_report_folder_gets_its_files_whole_or_keeps_the_old_ones(tmp_path):
+    # a report's files were written in place: a failed run left some new, some old
+    from stabilize.video.atomic import atomic_folder
+
+    report = tmp_path / "report"
+    with atomic_folder(report) as tmp:
+        for name in ("summary.json", "path.csv"):
+            (tmp / name).write_text("first")
+    with pytest.raises(RuntimeError), atomic_folder(report) as tmp:
+        (tmp / "summary.json").write_text("second")
+        raise RuntimeError("the plot failed")
+    assert {p.name: p.read_text() for p in report.iterdir()} == {
+        "summary.json": "first",
+        "path.csv": "first",
+    }
+    assert [p.name for p in tmp_path.iterdir()] == ["report"]  # no temporary folder left
