@@ -208,35 +208,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
         if first is None:
             notices += ("an image sequence keeps no frame times (--report's path.csv has them)",)
     notices += encoder_notice(encoding, settings.encoding.codec_for(container))
-    notices += dolby_vision_notice(info.colour.dolby_vision)
-    if info.colour.hdr10_plus:
-        notices += (
-            "HDR10+ (its tone mapping for each frame, SMPTE 2094-40) left out: it does not "
-            "travel through the pipe; the HDR10 picture and its static metadata are kept, "
-            "and play as HDR10",
-        )
-    if info.captions:
-        notices += (
-            "closed captions (EIA-608/708, carried in the video's frames) left out: they "
-            "do not travel through the pipe to the encoder",
-        )
-    if has_alpha(info.pix_fmt):
-        notices += (
-            f"the source's alpha (transparency, {info.pix_fmt}) is left out: the frames "
-            "are stabilised and written without it",
-        )
-    piped = piped_format(info, settings)
-    notices += chroma_notice(info.pix_fmt, piped, encoding.pix_fmt)
-    if pipe_format(piped) != "yuv420p" and pipe_format(encoding.pix_fmt) == "yuv420p":
-        notices += (
-            f"{info.pix_fmt} video written at 8 bits: {encoding.codec} "
-            f"({encoding.pix_fmt}) holds no more",
-        )
-    if info.colour.hdr10_lost(encoding.codec):
-        notices += (
-            f"HDR10's mastering display and light levels left out: {encoding.codec} does "
-            "not write them (libx264 and libx265 do)",
-        )
+    notices += pipe_notices(info, piped_format(info, settings), encoding)
     if not settings.size and frame_size(info, settings) != info.shown_framed_size:
         (h, w), (sh, sw) = frame_size(info, settings), info.shown_framed_size
         notices += (
@@ -256,6 +228,48 @@ def encoder_notice(encoding: Encoding, default: str) -> tuple[str, ...]:
         f"at 10 bits, where {default} at 10 bits plays in few players (--codec {default} "
         "keeps it)",
     )
+
+
+def pipe_notices(info: VideoInfo, piped: str, encoding: Encoding) -> tuple[str, ...]:
+    """Notices for what of the source's picture does not reach the output: what the
+    frames piped to the encoder as ``piped`` cannot carry (Dolby Vision's and HDR10+'s
+    metadata, closed captions, alpha, colour finer than 4:2:0, depth), or what the
+    ``encoding`` cannot write (HDR10's static metadata, depth)."""
+    notices = dolby_vision_notice(info.colour.dolby_vision)
+    if info.colour.hdr10_plus:
+        notices += (
+            "HDR10+ (its tone mapping for each frame, SMPTE 2094-40) left out: it does not "
+            "travel through the pipe; the HDR10 picture and its static metadata are kept, "
+            "and play as HDR10",
+        )
+    if info.captions:
+        notices += (
+            "closed captions (EIA-608/708, carried in the video's frames) left out: they "
+            "do not travel through the pipe to the encoder",
+        )
+    if has_alpha(info.pix_fmt):
+        notices += (
+            f"the source's alpha (transparency, {info.pix_fmt}) is left out: the frames "
+            "are stabilised and written without it",
+        )
+    notices += chroma_notice(info.pix_fmt, piped, encoding.pix_fmt)
+    if pipe_format(info.pix_fmt) != "yuv420p":  # a source of 10 bits or more
+        if pipe_format(piped) == "yuv420p":  # RGB, where a side is odd
+            notices += (
+                f"{info.pix_fmt} video written at 8 bits: with an odd side, its frames "
+                "travel to the encoder as 8-bit RGB",
+            )
+        elif pipe_format(encoding.pix_fmt) == "yuv420p":
+            notices += (
+                f"{info.pix_fmt} video written at 8 bits: {encoding.codec} "
+                f"({encoding.pix_fmt}) holds no more",
+            )
+    if info.colour.hdr10_lost(encoding.codec):
+        notices += (
+            f"HDR10's mastering display and light levels left out: {encoding.codec} does "
+            "not write them (libx264 and libx265 do)",
+        )
+    return notices
 
 
 def chroma_notice(source: str, piped: str, written: str) -> tuple[str, ...]:

@@ -72,7 +72,7 @@ def chroma(pix_fmt: str) -> str | None:
         return ":".join(planar.groups())
     if pix_fmt.startswith(("gray", "ya", "mono")):
         return ""
-    if re.match(r"(0?(rgb|bgr)|(rgb|bgr|gbr|argb|abgr)|pal8|x2(rgb|bgr)|gbrap?)", pix_fmt):
+    if re.match(r"(0|x2)?(rgb|bgr|gbr|argb|abgr)|pal8", pix_fmt):
         return "4:4:4"
     return next((j for j, names in _PACKED_CHROMA.items() if pix_fmt.startswith(names)), None)
 
