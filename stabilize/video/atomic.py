@@ -54,9 +54,10 @@ def atomic_output(path: str | os.PathLike, *, overwrite: bool = False) -> Iterat
         with _atomic_sequence(final) as tmp:
             yield tmp
         return
-    sweep_stale(final.parent, f".{final.stem}.*.partial*")
+    stem = short_stem(final.stem)
+    sweep_stale(final.parent, f".{stem}.*.partial*")
     fd, tmp = tempfile.mkstemp(
-        prefix=f".{final.stem}.{os.getpid()}.", suffix=f".partial{final.suffix}", dir=final.parent
+        prefix=f".{stem}.{os.getpid()}.", suffix=f".partial{final.suffix}", dir=final.parent
     )
     os.close(fd)
     tmp_path = Path(tmp)
@@ -96,6 +97,7 @@ def _atomic_sequence(final: Path) -> Iterator[Path]:
 def _staging(parent: Path, stem: str) -> Iterator[Path]:
     """A hidden temporary folder in ``parent`` (``.STEM.PID.RANDOM.partial``, so that a
     killed run's is swept by the next), removed after the block."""
+    stem = short_stem(stem)
     sweep_stale(parent, f".{stem}.*.partial")
     tmp = Path(tempfile.mkdtemp(prefix=f".{stem}.{os.getpid()}.", suffix=".partial", dir=parent))
     try:
@@ -112,6 +114,24 @@ def _move_in(tmp: Path, dest: Path) -> None:
     for made in sorted(tmp.iterdir()):
         os.chmod(made, 0o666 & ~umask)
         os.replace(made, dest / made.name)
+
+
+# Bytes a file's name may hold (ext4, APFS, NTFS: 255), and those a temporary name adds to
+# its stem: ".", ".PID.", 8 random, ".partial" and a suffix of up to 16
+NAME_MAX = 255
+TEMP_NAME_BYTES = 48
+
+
+def short_stem(stem: str) -> str:
+    """``stem`` cut, on a character's boundary, to leave a temporary name beside it within
+    :data:`NAME_MAX` bytes: a 249-character output's ``.NAME.PID.RANDOM.partial.mp4``
+    failed with "File name too long" once the work was done.
+
+    >>> len(short_stem("é" * 200).encode()), short_stem("take-1")
+    (206, 'take-1')
+    """
+    data = stem.encode()[: NAME_MAX - TEMP_NAME_BYTES]
+    return data.decode(errors="ignore")
 
 
 _OWNER = re.compile(r"\.(\d+)\.[^.]+\.partial")  # the pid in .NAME.PID.RANDOM.partial.SUFFIX

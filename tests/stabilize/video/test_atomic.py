@@ -85,3 +85,13 @@ def test_a_report_folder_gets_its_files_whole_or_keeps_the_old_ones(tmp_path):
         "path.csv": "first",
     }
     assert [p.name for p in tmp_path.iterdir()] == ["report"]  # no temporary folder left
+
+
+def test_a_name_near_the_longest_a_folder_holds_gets_a_temporary_name_beside_it(tmp_path):
+    # ".NAME.PID.RANDOM.partial.mp4" of a 249-character name: "File name too long",
+    # once all the work was done
+    final = tmp_path / ("é" * 120 + ".mp4")  # 244 bytes
+    with atomic_output(final) as tmp:
+        assert len(tmp.name.encode()) <= 255
+        tmp.write_bytes(b"video")
+    assert final.read_bytes() == b"video"
