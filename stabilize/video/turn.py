@@ -35,29 +35,38 @@ def turn(frame: NDArray, turns: int, planar: bool = False, mirror: bool = False)
     return i420.join(*(shown(p) for p in i420.split(frame))) if planar else shown(frame)
 
 
+# Seconds into the clip where the frame is read again, where the first cannot tell the
+# turn from the mirror (one colour: a fade in from black)
+LATER_S = (1.0, 3.0)
+
+
 def display_transform(
     path: str | Path, size: tuple[int, int], input_args: tuple = ()
 ) -> tuple[int, bool] | None:
-    """(quarter turns, mirror) that take the first frame as stored, (H, W) ``size``, to
-    the frame FFmpeg shows (:func:`turn`'s arguments), found by decoding it both ways;
-    None where the frame cannot tell (one colour, or symmetric), or does not decode.
+    """(quarter turns, mirror) that take a frame as stored, (H, W) ``size``, to the frame
+    FFmpeg shows (:func:`turn`'s arguments), found by decoding the first frame both ways,
+    or one :data:`LATER_S` in where it cannot tell (one colour, or symmetric); None where
+    none can, or none decodes.
 
     FFmpeg's listing gives a display matrix's rotation only, and a flip in it changes
     that: a mirror alone reads "rotation of -180 degrees", a vertical flip "-0.00". A
     clip so flagged (a front camera's, as some apps write it) came out upside down, or
     mirrored.
     """
-    stored, shown = (_first_luma(path, input_args, auto) for auto in (False, True))
-    if stored.size != size[0] * size[1] or shown.size != stored.size:
-        return None
-    stored = stored.reshape(size).astype(np.int16)
-    fits = [
-        (turns, mirror)
-        for mirror in (False, True)
-        for turns in range(4)
-        if _same(np.rot90(stored[:, ::-1] if mirror else stored, turns), shown)
-    ]
-    return fits[0] if len(fits) == 1 else None
+    for at in (None, *LATER_S):
+        stored, shown = (_luma(path, input_args, auto, at) for auto in (False, True))
+        if stored.size != size[0] * size[1] or shown.size != stored.size:
+            return None  # past the end, or no frame decodes
+        stored = stored.reshape(size).astype(np.int16)
+        fits = [
+            (turns, mirror)
+            for mirror in (False, True)
+            for turns in range(4)
+            if _same(np.rot90(stored[:, ::-1] if mirror else stored, turns), shown)
+        ]
+        if len(fits) == 1:
+            return fits[0]
+    return None
 
 
 def _same(candidate: NDArray, shown: NDArray) -> bool:
@@ -66,10 +75,12 @@ def _same(candidate: NDArray, shown: NDArray) -> bool:
     return bool(np.abs(candidate - shown.reshape(candidate.shape)).mean() < 0.5)
 
 
-def _first_luma(path: str | Path, input_args: tuple, autorotate: bool) -> NDArray:
-    """The first frame's luma, flat uint8 (empty where none decodes), turned by FFmpeg
-    or as stored."""
+def _luma(path: str | Path, input_args: tuple, autorotate: bool, at: float | None) -> NDArray:
+    """A frame's luma, flat uint8 (empty where none decodes), turned by FFmpeg or as
+    stored: the first, or the one ``at`` s in."""
     cmd = [ffmpeg_exe(), "-v", "error", "-nostdin", *input_args]
-    cmd += [*(() if autorotate else ("-noautorotate",)), "-i", local(path, "image2" in input_args)]
-    cmd += ["-map", "0:v:0", "-frames:v", "1", "-f", "rawvideo", "-pix_fmt", "gray", "-"]
+    cmd += ["-ss", f"{at:g}"] if at is not None else []
+    cmd += [] if autorotate else ["-noautorotate"]
+    cmd += ["-i", local(path, "image2" in input_args), "-map", "0:v:0", "-frames:v", "1"]
+    cmd += ["-f", "rawvideo", "-pix_fmt", "gray", "-"]
     return np.frombuffer(subprocess.run(cmd, capture_output=True).stdout, np.uint8)

@@ -89,6 +89,20 @@ def test_a_front_cameras_portrait_clip_comes_out_as_players_show_it(tmp_path):
         assert np.abs(written - wrong).mean() > 10
 
 
+def test_a_clip_that_fades_in_from_black_tells_its_flip_by_a_later_frame(tmp_path):
+    # its first frame, one colour, fits every turn and flip alike
+    faded = tmp_path / "faded.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(SAMPLE / "clip.mp4"), "-t", "1.5", "-an"]
+    subprocess.run(
+        [*cmd, "-vf", "fade=in:st=0:d=0.5", "-preset", "ultrafast", str(faded)], check=True
+    )
+    clip = tmp_path / "flipped.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-display_rotation", "90", "-display_hflip"]
+    subprocess.run([*cmd, "-i", str(faded), "-c", "copy", str(clip)], check=True)
+    info = probe(clip)
+    assert (info.rotation, info.mirror) == (270, True)
+
+
 def test_a_frame_that_cannot_tell_a_flip_keeps_the_listed_rotation(tmp_path):
     black = tmp_path / "black.mp4"
     cmd = [ffmpeg_exe(), "-v", "error", "-f", "lavfi", "-i", "color=black:s=64x48:d=0.2"]
