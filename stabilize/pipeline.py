@@ -44,7 +44,7 @@ from stabilize.path.zoom import CROP_MODES
 from stabilize.progress import ProgressFactory, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoInfo, atomic_output, frame_interval, frame_times, probe
-from stabilize.video.atomic import check_absent, is_sequence
+from stabilize.video.atomic import check_absent, check_not_input, is_sequence
 from stabilize.video.bars import BARS_MODES, detect_bars
 from stabilize.video.binary import local
 from stabilize.video.colour import DOLBY_BASE
@@ -524,12 +524,9 @@ def settings_summary(settings: Settings) -> dict:
 def _check_output(src: Path, dst: Path, overwrite: bool) -> None:
     """Refuse an output that is the input, that would replace any of the input's
     pictures, or that exists without ``overwrite``."""
-    # an image sequence's pattern names no one file
-    same = src.resolve() == dst.resolve() or (
-        dst.exists() and src.exists() and os.path.samefile(src, dst)
-    )
-    if same:
+    if src.resolve() == dst.resolve():  # (an image sequence's pattern names no one file)
         raise ValueError(f"the output {dst} is the input; choose another name")
+    check_not_input(dst, src)  # by another name: a link, another spelling
     if is_sequence(dst) and is_pattern(src):  # pictures beside pictures: none may be lost
         inputs = {p.resolve() for p in sequence_files(src).values()}
         replaced = {p.resolve() for p in sequence_files(dst).values()}  # with --overwrite

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from stabilize.cli.app import app, fail
+from stabilize.cli.app import app, fail, run_or_fail
 from stabilize.cli.bars import progress_bar
 from stabilize.cli.options import FpsOption, QuietOption
 
@@ -61,6 +61,10 @@ def evaluate(
         fail(f"--plot {plot}: give a .png file")
     if plot is not None and not plot.parent.is_dir():
         fail(f"--plot {plot}: no such folder {plot.parent}")
+    if plot is not None:
+        from stabilize.video.atomic import check_not_input
+
+        run_or_fail(lambda: check_not_input(plot, original, stabilised))
     try:
         info_o = probe(original, sequence_args(original, fps=fps))
         info_s = probe(stabilised, sequence_args(stabilised, fps=fps))

@@ -57,12 +57,16 @@ def rotations(
     from stabilize.motion.files import write_rotations
     from stabilize.motion.focal import estimate_motion
     from stabilize.video import atomic_output, probe, sequence_args
+    from stabilize.video.atomic import check_not_input
     from stabilize.video.preflight import check_writable
 
     if output is None and gcsv is None:
         fail("give -o rotations.csv and/or --gcsv out.gcsv")
     targets = [t for t in (output, gcsv) if t is not None]
+    if len(targets) == 2 and output.resolve() == gcsv.resolve():
+        fail(f"-o and --gcsv both name {output}: give each its own file")
     for target in targets:  # before any work, not after it
+        run_or_fail(lambda target=target: check_not_input(target, input_path))
         if target.exists() and not overwrite:
             fail(f"{target} exists (use --overwrite to replace it)")
         run_or_fail(lambda target=target: check_writable(target))

@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 
 from stabilize.cli.app import app, fail
-from stabilize.cli.options import QuietOption, output_size
+from stabilize.cli.options import OverwriteOption, QuietOption, output_size
 
 
 def _default_panorama() -> Path | None:
@@ -55,12 +55,17 @@ def synth(
     procedural: bool = typer.Option(
         False, help="Use the procedural skyline even if the photograph is present."
     ),
+    overwrite: OverwriteOption = False,
     quiet: QuietOption = False,
 ) -> None:
     """Render a shaky handheld street clip whose every rotation is known, with its gyro log."""
     from stabilize.cli.bars import progress_bar
-    from stabilize.synth import SynthOptions, render_clip
+    from stabilize.synth import SYNTH_FILES, SynthOptions, render_clip
 
+    # a folder of one's own clips may hold a clip.mp4: replaced silently before
+    found = [name for name in SYNTH_FILES if (out_dir / name).exists()]
+    if found and not overwrite:
+        fail(f"{out_dir} holds {', '.join(found)} (use --overwrite to replace them)")
     bg = None if procedural else (background or _default_panorama())
     if bg is not None and not Path(bg).is_file():
         fail(f"background image not found: {bg}")

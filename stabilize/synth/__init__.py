@@ -198,6 +198,10 @@ def gyro_samples(opts: SynthOptions) -> tuple[NDArray, NDArray]:
     return t + opts.gyro_offset, omega_imu
 
 
+# What :func:`render_clip` writes into its folder
+SYNTH_FILES = ("clip.mp4", "truth.csv", "truth.json", "gyro.csv", "timestamps.csv")
+
+
 def write_truth(out: Path, opts: SynthOptions) -> None:
     t = clip_times(opts)
     O = trajectory.orientation(opts.motion, t)
@@ -259,4 +263,11 @@ def render_clip(
     }
 
 
-__all__ = ["SynthOptions", "build_scene", "render_clip", "render_frames", "write_truth"]
+__all__ = [
+    "SYNTH_FILES",
+    "SynthOptions",
+    "build_scene",
+    "render_clip",
+    "render_frames",
+    "write_truth",
+]

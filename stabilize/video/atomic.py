@@ -30,6 +30,20 @@ def check_absent(path: str | os.PathLike, overwrite: bool) -> None:
         raise FileExistsError(f"{final} exists (use --overwrite to replace it)")
 
 
+def check_not_input(output: str | os.PathLike, *inputs: str | os.PathLike) -> None:
+    """ValueError where writing ``output`` would replace one of ``inputs``: the same file
+    by any name (a link, another spelling), or a picture of an input image sequence.
+    ``--overwrite`` never reaches an input: ``rotations clip.mp4 -o clip.mp4`` replaced
+    the clip with its CSV, and ``evaluate --plot`` a picture of its input sequence."""
+    out = Path(output)
+    if not out.exists():
+        return
+    for source in inputs:
+        files = sequence_files(source).values() if is_pattern(source) else [Path(source)]
+        if any(f.exists() and os.path.samefile(f, out) for f in files):
+            raise ValueError(f"{out} is the input {source}; choose another name")
+
+
 def is_sequence(path: Path) -> bool:
     """Whether an output is an image sequence: a pattern in a picture format's suffix
     (``frames/%05d.png``; a video named ``50%done.mp4`` is one file)."""

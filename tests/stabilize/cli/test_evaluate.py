@@ -55,3 +55,19 @@ def test_evaluate_reads_an_image_sequence_at_the_rate_given(tmp_path):
         assert result.exit_code == 0, result.output
         shake[fps] = json.loads(result.stdout)["original"]["residual_shake_px"]
     assert shake["10"] < shake["60"]
+
+
+def test_the_plot_never_replaces_an_input(tmp_path):
+    # --plot f001.png wrote the plot over the input sequence's first picture
+    import subprocess
+
+    from stabilize.video import ffmpeg_exe
+
+    frames = tmp_path / "f%03d.png"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", "samples/street/clip.mp4", "-frames:v", "6"]
+    subprocess.run([*cmd, str(frames)], check=True)
+    before = (tmp_path / "f001.png").read_bytes()
+    args = ["evaluate", str(frames), str(frames), "--plot", str(tmp_path / "f001.png"), "-q"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2 and "is the input" in result.output
+    assert (tmp_path / "f001.png").read_bytes() == before

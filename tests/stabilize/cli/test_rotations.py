@@ -23,3 +23,18 @@ def test_a_clip_held_upright_gives_its_sensors_rotations(shaky, tmp_path):
         assert CliRunner().invoke(app, args).exit_code == 0
         files.append(out.read_text())
     assert files[1] == files[0]
+
+
+def test_the_output_never_replaces_the_input(shaky, tmp_path):
+    # -o clip.mp4 --overwrite replaced the clip with its CSV
+    clip = tmp_path / "clip.mp4"
+    clip.write_bytes(shaky.read_bytes())
+    link = tmp_path / "link.mp4"
+    link.symlink_to(clip)
+    for args in (["-o", str(clip)], ["--gcsv", str(link)]):
+        result = CliRunner().invoke(app, ["rotations", str(clip), *args, "--overwrite", "-q"])
+        assert result.exit_code == 2 and "is the input" in result.output
+    same = ["-o", str(tmp_path / "r.csv"), "--gcsv", str(tmp_path / "r.csv")]
+    result = CliRunner().invoke(app, ["rotations", str(clip), *same, "-q"])
+    assert result.exit_code == 2 and "give each its own file" in result.output
+    assert clip.read_bytes() == shaky.read_bytes()

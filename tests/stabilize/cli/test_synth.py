@@ -34,3 +34,14 @@ def test_synth_command_writes_clip_truth_and_gyro(tmp_path):
 def test_synth_rejects_a_missing_background(tmp_path):
     result = CliRunner().invoke(app, ["synth", str(tmp_path), "--background", "nope.jpg"])
     assert result.exit_code != 0 and "not found" in result.output
+
+
+def test_synth_replaces_files_in_its_folder_only_with_overwrite(tmp_path):
+    # a folder of one's own clips may hold a clip.mp4: replaced silently before
+    (tmp_path / "clip.mp4").write_bytes(b"my holiday")
+    args = ["synth", str(tmp_path), "--seconds", "0.2", "--size", "160x90", "--procedural", "-q"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2 and "holds clip.mp4" in result.output
+    assert (tmp_path / "clip.mp4").read_bytes() == b"my holiday"
+    assert CliRunner().invoke(app, [*args, "--overwrite"]).exit_code == 0
+    assert probe(tmp_path / "clip.mp4").size == (90, 160)
