@@ -51,7 +51,7 @@ from stabilize.video.colour import DOLBY_BASE
 from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Encoding, Mux
 from stabilize.video.fields import DEINTERLACE_MODES, field_times
-from stabilize.video.i420 import chroma, has_alpha, pipe_format
+from stabilize.video.i420 import chroma, pipe_format
 from stabilize.video.preflight import check_encoder, check_writable, describe
 from stabilize.video.sequence import (
     first_image,
@@ -247,7 +247,7 @@ def pipe_notices(info: VideoInfo, piped: str, encoding: Encoding) -> tuple[str, 
             "closed captions (EIA-608/708, carried in the video's frames) left out: they "
             "do not travel through the pipe to the encoder",
         )
-    if has_alpha(info.pix_fmt):
+    if info.alpha:
         notices += (
             f"the source's alpha (transparency, {info.pix_fmt}) is left out: the frames "
             "are stabilised and written without it",

@@ -16,7 +16,7 @@ from stabilize.video.binary import ffmpeg_exe, local
 from stabilize.video.colour import UNKNOWN, Colour, colour_of, dolby_vision, with_hdr10
 from stabilize.video.fields import DEINTERLACE_MODES, field_order, frame_field_order, interlaced
 from stabilize.video.first_frame import first_frame_report
-from stabilize.video.i420 import pipe_format
+from stabilize.video.i420 import has_alpha, pipe_format
 from stabilize.video.sequence import (
     exif_orientation,
     first_image,
@@ -85,6 +85,10 @@ class VideoInfo:
     # closed captions (EIA-608/708, a broadcast's) carried in the video's own frames,
     # which FFmpeg's listing names on the stream's line
     captions: bool = False
+    # whether the frames carry an alpha (transparency) plane the pipe leaves out: its
+    # pixel format has one, and, for a GIF (which FFmpeg decodes as bgra whatever it
+    # holds), some frame of it declares a transparent colour
+    alpha: bool = False
     # whether the shown frames are the stored ones mirrored left to right, before the
     # display rotation turns them: a display matrix with a flip (a front camera's)
     mirror: bool = False
@@ -313,4 +317,17 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
         coded=coded,
         captions="Closed Captions" in stream_line,
         mirror=mirror,
+        alpha=has_alpha(pix_fmt) and (codec != "gif" or _gif_transparent(path)),
     )
+
+
+def _gif_transparent(path: Path) -> bool:
+    """Whether some frame of a GIF declares a transparent colour (True where it cannot be
+    read: the notice errs on the side of saying)."""
+    try:
+        from PIL import Image, ImageSequence
+
+        with Image.open(path) as gif:
+            return any("transparency" in frame.info for frame in ImageSequence.Iterator(gif))
+    except (OSError, ValueError, ImportError):
+        return True

@@ -291,3 +291,17 @@ def test_a_gif_keeps_every_frame_and_its_time_and_loops(attached, tmp_path):
     pairs = zip(read_frames(out), read_frames(mp4), strict=True)
     gaps = [np.abs(a.astype(int) - b).mean() for a, b in pairs]
     assert len(gaps) == 60 and max(gaps) < 4
+
+
+def test_a_gif_says_it_carries_alpha_only_where_it_declares_transparency(shaky, tmp_path):
+    # FFmpeg decodes every GIF as bgra: an opaque one was said to lose its alpha
+    opaque, clear = tmp_path / "opaque.gif", tmp_path / "clear.gif"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-frames:v", "5"]
+    subprocess.run([*cmd, str(opaque)], check=True)
+    keyed = "format=rgba,colorkey=0x808080:0.4,split[a][b];[a]palettegen=reserve_transparent=1[p];"
+    keyed += "[b][p]paletteuse=alpha_threshold=128"
+    subprocess.run([*cmd, "-filter_complex", keyed, str(clear)], check=True)
+    assert [(probe(p).pix_fmt, probe(p).alpha) for p in (opaque, clear)] == [
+        ("bgra", False),
+        ("bgra", True),
+    ]
