@@ -61,10 +61,11 @@ def evaluate(
         fail(f"--plot {plot}: give a .png file")
     if plot is not None and not plot.parent.is_dir():
         fail(f"--plot {plot}: no such folder {plot.parent}")
-    if plot is not None:
-        from stabilize.video.atomic import check_not_input
+    if plot is not None:  # (an older plot is replaced; a folder, or an input, never)
+        from stabilize.video.atomic import check_absent, check_not_input
 
         run_or_fail(lambda: check_not_input(plot, original, stabilised))
+        run_or_fail(lambda: check_absent(plot, overwrite=True))
     try:
         info_o = probe(original, sequence_args(original, fps=fps))
         info_s = probe(stabilised, sequence_args(stabilised, fps=fps))

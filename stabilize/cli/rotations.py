@@ -57,7 +57,7 @@ def rotations(
     from stabilize.motion.files import write_rotations
     from stabilize.motion.focal import estimate_motion
     from stabilize.video import atomic_output, probe, sequence_args
-    from stabilize.video.atomic import check_not_input
+    from stabilize.video.atomic import check_absent, check_not_input
     from stabilize.video.preflight import check_writable
 
     if output is None and gcsv is None:
@@ -67,8 +67,7 @@ def rotations(
         fail(f"-o and --gcsv both name {output}: give each its own file")
     for target in targets:  # before any work, not after it
         run_or_fail(lambda target=target: check_not_input(target, input_path))
-        if target.exists() and not overwrite:
-            fail(f"{target} exists (use --overwrite to replace it)")
+        run_or_fail(lambda target=target: check_absent(target, overwrite))
         run_or_fail(lambda target=target: check_writable(target))
     settings = flow_settings(flow_name, raft_weights, device, fov=field_of_view(fov), focal=focal)
     # the sensor's axes, as compare's

@@ -17,8 +17,14 @@ from stabilize.video.sequence import is_pattern, sequence_files
 
 def check_absent(path: str | os.PathLike, overwrite: bool) -> None:
     """FileExistsError where ``path`` exists (an image sequence: any of its pictures)
-    and may not be replaced."""
+    and may not be replaced; ValueError where it is a folder, which no output replaces
+    (``out.mp4/`` made by mistake: the run failed once its work was done)."""
     final = Path(path)
+    if final.is_dir():
+        raise ValueError(
+            f"{final} is a folder: name the output file, e.g. {final / 'out'}"
+            f"{final.suffix or '.mp4'}"
+        )
     if overwrite:
         return
     if is_sequence(final) and (found := sequence_files(final)):

@@ -60,6 +60,9 @@ CASES = {
     "video encoder for pictures": Case(("--codec", "libx264"), 2, out="f%02d.png"),
     "report is a file": Case(("--report", "{dir}/notes.txt"), 2, files={"notes.txt": "x"}),
     "rotations onto an existing file": Case(("-o", "{dir}/r.csv"), 2, files={"r.csv": "x"}),
+    # a folder named as the output: it failed once the work was done, "Is a directory"
+    "output is a folder": Case(("--overwrite",), 2, out="o.mp4", files={"o.mp4/keep": "x"}),
+    "rotations onto a folder": Case(("-o", "{dir}/r", "--overwrite"), 2, files={"r/keep": "x"}),
     # bad options
     "unknown option": Case(("--frobnicate",), 2),
     "flow": Case(("--flow", "sift"), 2),
@@ -206,6 +209,7 @@ def no_decoding(monkeypatch):
 def test_the_battery(name, shaky, tmp_path, monkeypatch, capsys, request):
     case = CASES[name]
     for file, text in case.files.items():
+        (tmp_path / file).parent.mkdir(parents=True, exist_ok=True)
         (tmp_path / file).write_text(text)
     source = make_input(case.source, shaky, tmp_path)
     out = Path(case.out.format(input=source)) if "{" in case.out else tmp_path / case.out

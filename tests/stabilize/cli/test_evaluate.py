@@ -34,7 +34,9 @@ def test_evaluate_draws_the_shake(tmp_path):
     result = CliRunner().invoke(app, ["evaluate", sample, sample, "--plot", str(png), "-q"])
     assert result.exit_code == 0, result.output
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
+    (tmp_path / "folder.png").mkdir()  # an internal error once the work was done, before
     wrongs = {"shake.txt": "give a .png file", "no/shake.png": "no such folder"}
+    wrongs["folder.png"] = "is a folder"
     for wrong, why in wrongs.items():
         bad = CliRunner().invoke(app, ["evaluate", sample, sample, "--plot", str(tmp_path / wrong)])
         assert bad.exit_code == 2 and why in bad.output
