@@ -83,10 +83,7 @@ def atomic_output(path: str | os.PathLike, *, overwrite: bool = False) -> Iterat
     tmp_path = Path(tmp)
     try:
         yield tmp_path
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp_path, 0o666 & ~umask)  # mkstemp makes it private; outputs are not
-        os.replace(tmp_path, final)
+        _publish(tmp_path, final)
     finally:
         tmp_path.unlink(missing_ok=True)
 
@@ -127,13 +124,18 @@ def _staging(parent: Path, stem: str) -> Iterator[Path]:
 
 
 def _move_in(tmp: Path, dest: Path) -> None:
-    """Every file made in ``tmp`` moved into ``dest``, each replacing its namesake, with
-    the permissions outputs get (mkstemp makes files private)."""
+    """Every file made in ``tmp`` moved into ``dest``, each replacing its namesake."""
+    for made in sorted(tmp.iterdir()):
+        _publish(made, dest / made.name)
+
+
+def _publish(made: Path, final: Path) -> None:
+    """``made`` renamed onto ``final``, with the permissions outputs get: mkstemp and
+    mkdtemp make what they create private."""
     umask = os.umask(0)
     os.umask(umask)
-    for made in sorted(tmp.iterdir()):
-        os.chmod(made, 0o666 & ~umask)
-        os.replace(made, dest / made.name)
+    os.chmod(made, 0o666 & ~umask)
+    os.replace(made, final)
 
 
 # Bytes a file's name may hold (ext4, APFS, NTFS: 255), and those a temporary name adds to

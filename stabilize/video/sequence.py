@@ -29,6 +29,13 @@ def is_pattern(path: str | Path) -> bool:
     return bool(_NUMBER.search(Path(path).name)) and not Path(path).is_file()
 
 
+def _split(name: str) -> tuple[str, re.Match, str] | None:
+    """A pattern's file name around its frame number: (before, the number's spec,
+    after), or None where it holds none."""
+    spec = _NUMBER.search(name)
+    return None if spec is None else (name[: spec.start()], spec, name[spec.end() :])
+
+
 def image2_path(pattern: str | Path) -> str:
     """An image-sequence pattern as FFmpeg's image2 reads it: every ``%`` but the frame
     number's doubled, since FFmpeg takes a ``%`` anywhere in the path, its folders' names
@@ -39,11 +46,11 @@ def image2_path(pattern: str | Path) -> str:
     '/clips/100%% sharp/img%%-%05d.png'
     """
     folder, name = os.path.split(str(pattern))
-    number = _NUMBER.search(name)
-    if number is None:
+    parts = _split(name)
+    if parts is None:
         return str(pattern).replace("%", "%%")
-    head, tail = name[: number.start()], name[number.end() :]
-    name = head.replace("%", "%%") + number.group() + tail.replace("%", "%%")
+    head, spec, tail = parts
+    name = head.replace("%", "%%") + spec.group() + tail.replace("%", "%%")
     return os.path.join(folder.replace("%", "%%"), name)
 
 
@@ -55,11 +62,11 @@ def picture(pattern: str | Path, number: int) -> Path:
     '/clips/50% off/img-00099.jpg'
     """
     path = Path(pattern)
-    number_at = _NUMBER.search(path.name)
-    if number_at is None:
+    parts = _split(path.name)
+    if parts is None:
         return path
-    head, tail = path.name[: number_at.start()], path.name[number_at.end() :]
-    return path.with_name(head + _digits(number_at, number) + tail)
+    head, spec, tail = parts
+    return path.with_name(head + _digits(spec, number) + tail)
 
 
 def sequence_files(pattern: str | Path) -> dict[int, Path]:
@@ -69,10 +76,10 @@ def sequence_files(pattern: str | Path) -> dict[int, Path]:
     {}
     """
     path = Path(pattern)
-    spec = _NUMBER.search(path.name)
-    if spec is None or not path.parent.is_dir():
+    parts = _split(path.name)
+    if parts is None or not path.parent.is_dir():
         return {}
-    head, tail = path.name[: spec.start()], path.name[spec.end() :]
+    head, spec, tail = parts
     name = re.compile(re.escape(head) + r"(\d+)" + re.escape(tail) + "$")
     found = ((name.match(p.name), p) for p in path.parent.iterdir())
     # only the digits FFmpeg writes for the number: a looser match took 0001.png for a
