@@ -1,11 +1,13 @@
 """Stabilising a folder of clips: worker processes, a manifest, resume, isolated failures.
 
 Every input gets a row in ``OUT_DIR/manifest.json`` (and ``manifest.csv``): its status
-(``done``, ``skipped`` or ``failed``), seconds, output path, error, and the key quality
-figures. The manifest is rewritten after every file, and an output only ever appears under
-its final name once complete (the pipeline writes atomically), so a run that is killed can
-simply be started again: inputs whose output is complete and whose size and modification
-time match the manifest are skipped.
+(``done``, ``skipped`` or ``failed``; ``started`` until it ends), seconds, output path,
+error, and the key quality figures. The manifest is rewritten after every file, and an
+output only ever appears under its final name once complete (the pipeline writes
+atomically), so a run that is killed can simply be started again: inputs whose output is
+complete and whose size and modification time match the manifest are skipped. A file at
+an output's name that the manifest lists as no batch's output is the user's own, and is
+left as it is.
 """
 
 from __future__ import annotations
@@ -41,25 +43,45 @@ class Job:
     gyro: str | None = None
 
 
+# A clip's file, by its suffix (any case): what cameras, phones, camcorders and editors
+# write. Without --pattern a folder's photos, sidecars and notes are left out, and so are
+# a camera's proxies and thumbnails (GoPro's .LRV and .THM beside each .MP4).
+CLIP_SUFFIXES = frozenset(
+    {".mp4", ".m4v", ".mov", ".qt", ".mkv", ".webm", ".avi", ".mts", ".m2ts", ".ts"}
+    | {".mpg", ".mpeg", ".vob", ".mod", ".tod", ".3gp", ".3g2", ".wmv", ".asf", ".flv"}
+    | {".f4v", ".ogv", ".mxf", ".dv", ".y4m"}
+)
+
+
 def find_jobs(
     in_dir: Path,
     out_dir: Path,
-    pattern: str = "*",
+    pattern: str | None = None,
     recursive: bool = False,
     gyro_auto: bool = False,
     suffix: str | None = None,
+    notify: Callable[[str], None] | None = None,
 ) -> list[Job]:
-    """One job per matching file, the output mirroring its place in the input tree, with
-    the input's suffix (so its container) or ``suffix`` (``--format``)."""
+    """One job per clip (every file ``pattern`` matches, or, without one, every file
+    named as a video: :data:`CLIP_SUFFIXES`), the output mirroring its place in the input
+    tree, with the input's suffix (so its container) or ``suffix`` (``--format``).
+    ``notify`` hears of the files left out as not named like a video.
+
+    Two inputs that would share an output (``a.mov`` and ``a.mp4`` under ``--format
+    mp4``; names that differ only in case, one file on a case-blind disk) each get their
+    own: the one whose name it is keeps it, the other's takes its full name
+    (``a.mov.mp4``), and ``notify`` hears of it.
+    """
     in_dir, out_dir = Path(in_dir).resolve(), Path(out_dir).resolve()
-    paths = in_dir.rglob(pattern) if recursive else in_dir.glob(pattern)
-    jobs = []
-    for path in sorted(p for p in paths if p.is_file()):
-        if out_dir in path.parents or path.name.startswith("."):
-            continue
+    tell = notify or (lambda _: None)
+    jobs, left_out = [], []
+    for path in _files(in_dir, out_dir, pattern or "*", recursive):
+        rel = path.relative_to(in_dir)
         if gyro_auto and path.suffix.lower() in GYRO_SIDECARS:
             continue  # a sidecar, not a clip
-        rel = path.relative_to(in_dir)
+        if pattern is None and path.suffix.lower() not in CLIP_SUFFIXES:
+            left_out.append(rel.as_posix())
+            continue
         sidecar = next(
             (
                 path.with_suffix(s)
@@ -79,7 +101,50 @@ def find_jobs(
                 str(sidecar) if sidecar else None,
             )
         )
-    return jobs
+    if left_out:
+        shown = ", ".join(left_out[:3]) + (", …" if len(left_out) > 3 else "")
+        tell(
+            f"{len(left_out)} file(s) not named as videos left out ({shown}); "
+            "--pattern '*' takes every file"
+        )
+    return _distinct_outputs(jobs, tell)
+
+
+def _files(in_dir: Path, out_dir: Path, pattern: str, recursive: bool) -> list[Path]:
+    """The files under ``in_dir`` that ``pattern`` matches, in order, but for hidden ones
+    and those in ``out_dir``."""
+    paths = in_dir.rglob(pattern) if recursive else in_dir.glob(pattern)
+    return [
+        path
+        for path in sorted(p for p in paths if p.is_file())
+        if out_dir not in path.parents and not path.name.startswith(".")
+    ]
+
+
+def _distinct_outputs(jobs: list[Job], notify: Callable[[str], None]) -> list[Job]:
+    """``jobs`` with no output shared, compared case-blind (see :func:`find_jobs`);
+    a clash left after renaming (an input itself named ``a.mov.mp4``) is refused."""
+    taken: dict[str, Job] = {}
+    outputs: dict[str, str] = {}
+    # first those whose output is named as their input: they keep that name
+    for job in sorted(jobs, key=lambda j: Path(j.output).name != Path(j.input).name):
+        output = Path(job.output)
+        if (first := taken.get(str(output).casefold())) is not None:
+            renamed = output.with_name(Path(job.input).name + output.suffix)
+            if str(renamed).casefold() in taken:
+                raise ValueError(
+                    f"{first.input} and {job.input} would both be written as {output}, "
+                    f"and {renamed} is taken too: rename one, or pick with --pattern"
+                )
+            notify(
+                f"{first.input} and {job.input} would both be written as "
+                f"{Path(outputs[first.input]).name}: "
+                f"{job.input} goes to {renamed.name}"
+            )
+            output = renamed
+        taken[str(output).casefold()] = job
+        outputs[job.input] = str(output)
+    return [replace(job, output=outputs[job.input]) for job in jobs]
 
 
 def load_manifest(out_dir: Path) -> dict[str, dict]:
@@ -183,7 +248,7 @@ def run_job(job: Job, settings, on_frames: Callable[[int], None] | None = None) 
         return advance
 
     start = time.perf_counter()
-    row = {"input": job.input, "output": job.output, "size": job.size, "mtime": job.mtime}
+    row = job_row(job)
     row["settings"] = settings_key(settings)
     try:
         if job.gyro:
@@ -241,7 +306,9 @@ def run_batch(
 ) -> list[dict]:
     """Run the jobs not already complete (all of them with ``force``); returns every
     job's row, in input order. A job counts as complete when the same input was done
-    with the same settings (a hash of them is kept in the manifest).
+    with the same settings (a hash of them is kept in the manifest). A job whose output
+    name holds a file that no batch wrote there (the manifest lists no such output) is
+    left undone, a failed row, the file as it is (``force`` replaces it).
 
     ``on_done(row)`` hears of every file as it finishes, ``on_frames(n)`` of frames
     written (local workers; Ray tasks report files only).
@@ -254,16 +321,23 @@ def run_batch(
     sweep_stale(out_dir, recursive=True)  # a killed run's leftovers, never a running one's
     previous = load_manifest(out_dir)
     key = settings_key(settings)
+    ours = {row.get("output") for row in previous.values() if not row.get("foreign")}
     rows: dict[str, dict] = {}
     todo = []
     for job in jobs:
         if not force and is_complete(job, previous.get(job.input), key):
             rows[job.input] = {**previous[job.input], "status": "skipped", "seconds": 0.0}
-            if on_done:
-                on_done(rows[job.input])
+        elif not force and job.output not in ours and os.path.lexists(job.output):
+            rows[job.input] = _foreign(job)
         else:
             todo.append(job)
-    write_manifest(out_dir, {**previous, **rows})
+            continue
+        if on_done:
+            on_done(rows[job.input])
+    # the outputs claimed before any is written: a run killed after an output's rename
+    # and before its row leaves it a row, "started", so it is never taken for a stranger's
+    started = {job.input: job_row(job, status="started", error="") for job in todo}
+    write_manifest(out_dir, {**previous, **started, **rows})
     rows_in = (
         _execute_ray(todo, settings, ray_address)
         if ray_address
@@ -271,10 +345,22 @@ def run_batch(
     )
     for row in rows_in:
         rows[row["input"]] = row
-        write_manifest(out_dir, {**previous, **rows})
+        write_manifest(out_dir, {**previous, **started, **rows})
         if on_done:
             on_done(row)
     return [rows[job.input] for job in jobs]
+
+
+def job_row(job: Job, **fields) -> dict:
+    """A job's manifest row: what it reads and writes, and ``fields``."""
+    return {"input": job.input, "output": job.output, "size": job.size, "mtime": job.mtime} | fields
+
+
+def _foreign(job: Job) -> dict:
+    """The row of a job whose output's name holds a file this folder's batches did not
+    write (the manifest lists none there): left as it is, unless ``--force``."""
+    error = f"{job.output} is there already, and not from a batch (--force replaces it)"
+    return job_row(job, status="failed", error=error, seconds=0.0, foreign=True)
 
 
 def _execute(
@@ -326,4 +412,4 @@ def _execute_ray(jobs: list[Job], settings, address: str) -> Iterator[dict]:
         yield ray.get(ready[0])
 
 
-__all__ = ["Job", "find_jobs", "load_manifest", "run_batch"]
+__all__ = ["CLIP_SUFFIXES", "Job", "find_jobs", "load_manifest", "run_batch"]

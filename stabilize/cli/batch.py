@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from stabilize.cli.app import announce_compiling, app, fail, run_or_fail
+from stabilize.cli.app import announce_compiling, app, fail, notice, run_or_fail
 from stabilize.cli.options import (
     ENCODING,
     GYRO_SEARCH,
@@ -58,7 +58,11 @@ def batch(
     in_dir: Path = typer.Argument(..., help="Folder of clips."),
     out_dir: Path = typer.Argument(..., help="Where the stabilised clips go (same tree)."),
     workers: int | None = typer.Option(None, min=1, help="Parallel files (default: per core)."),
-    pattern: str = typer.Option("*", help="Which files, as a glob."),
+    pattern: str | None = typer.Option(
+        None,
+        help="Which files, as a glob (default: every file named as a video: .mp4, .mov, "
+        ".mkv, .mts, … in any case; not a camera's proxies, .LRV).",
+    ),
     recursive: bool = typer.Option(False, help="Descend into subfolders."),
     gyro: str | None = typer.Option(
         None, help=f"'auto': use the gyro log beside each clip, of the same name ({SIDECARS})."
@@ -68,7 +72,12 @@ def batch(
         "--format",
         help="Write every clip as this container, e.g. .mkv (default: each input's).",
     ),
-    force: bool = typer.Option(False, "--force", help="Redo every file, finished or not."),
+    force: bool = typer.Option(
+        False,
+        "--force",
+        help="Redo every file, finished or not, and replace files at the outputs' names "
+        "that no batch wrote.",
+    ),
     ray: str | None = typer.Option(
         None, help="Run on a Ray cluster: its address, or 'auto' (needs the 'cluster' extra)."
     ),
@@ -144,9 +153,11 @@ def _jobs(params: dict, settings) -> list:
         # every clip under the output folder is taken for an output and skipped: this
         # read "no files match" before
         fail(f"{out_dir}: the output folder holds the input folder {in_dir}: choose one outside it")
-    jobs = find_jobs(in_dir, out_dir, pattern, params["recursive"], gyro_auto, suffix)
+    jobs = run_or_fail(
+        lambda: find_jobs(in_dir, out_dir, pattern, params["recursive"], gyro_auto, suffix, notice)
+    )
     if not jobs:
-        fail(f"{in_dir}: no files match {pattern!r}")
+        fail(f"{in_dir}: no files match {pattern!r}" if pattern else f"{in_dir}: no videos")
     return jobs
 
 

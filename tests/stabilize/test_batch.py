@@ -147,3 +147,76 @@ def test_frames_written_are_reported_from_every_worker(folder, tmp_path, workers
     frames, files = [], []
     run_batch(jobs, tmp_path / "out", Settings(), workers, files.append, on_frames=frames.append)
     assert len(files) == 2 and sum(frames) == 2 * 90
+
+
+def test_only_videos_are_taken_and_the_rest_is_named(folder, tmp_path):
+    for name in ("photo.JPG", "GX010001.LRV", "GX010001.THM", "IMG_1.AAE"):
+        (folder / name).write_bytes(b"x")
+    (folder / "b.MTS").write_bytes(b"x")
+    heard: list[str] = []
+    jobs = find_jobs(folder, tmp_path / "out", notify=heard.append)
+    assert [j.input for j in jobs] == ["a.mp4", "b.MTS", "corrupt.mp4", "notes.mov"]
+    assert heard == [
+        "4 file(s) not named as videos left out (GX010001.LRV, GX010001.THM, IMG_1.AAE, …); "
+        "--pattern '*' takes every file"
+    ]
+    assert len(find_jobs(folder, tmp_path / "out", "*")) == 8  # a pattern takes what it names
+
+
+def test_two_inputs_never_share_an_output(folder, tmp_path):
+    # a.mov and a.mp4 under --format mp4: the second was written over the first, and
+    # both rows read "done"
+    (folder / "a.mov").write_bytes(b"x")
+    (folder / "A.MP4").write_bytes(b"x")
+    heard: list[str] = []
+    jobs = find_jobs(folder, tmp_path / "out", suffix=".mp4", notify=heard.append)
+    outputs = {j.input: Path(j.output).name for j in jobs}
+    assert outputs == {
+        "A.MP4": "A.MP4.mp4",  # a case-blind disk holds one of A.mp4 and a.mp4
+        "a.mov": "a.mov.mp4",
+        "a.mp4": "a.mp4",
+        "corrupt.mp4": "corrupt.mp4",
+        "notes.mov": "notes.mp4",
+    }
+    assert "a.mp4 and a.mov would both be written as a.mp4: a.mov goes to a.mov.mp4" in heard
+    (folder / "a.mov.mp4").write_bytes(b"x")  # its renaming is taken too: refused
+    with pytest.raises(ValueError, match="taken too"):
+        find_jobs(folder, tmp_path / "out", suffix=".mp4")
+
+
+def test_a_file_no_batch_wrote_is_left_as_it_is(folder, tmp_path):
+    from stabilize import Settings
+    from stabilize.batch import run_batch
+
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "corrupt.mp4").write_text("the user's own\n")
+    jobs = find_jobs(folder, out, "corrupt.mp4")
+    for _ in range(2):  # and again on a rerun, though the manifest now names it
+        (row,) = run_batch(jobs, out, Settings())
+        assert row["status"] == "failed" and "--force replaces it" in row["error"]
+        assert (out / "corrupt.mp4").read_text() == "the user's own\n"
+    (row,) = run_batch(jobs, out, Settings(), force=True)  # tried, so the input's error
+    assert "not from a batch" not in row["error"] and "corrupt.mp4" in row["error"]
+
+
+def test_an_output_a_killed_run_wrote_is_still_its_own(folder, tmp_path, monkeypatch):
+    import stabilize.batch as batch
+    from stabilize import Settings
+
+    out = tmp_path / "out"
+    jobs = find_jobs(folder, out, "corrupt.mp4")
+
+    def killed_after_the_rename(todo, *_):
+        Path(todo[0].output).write_text("made\n")
+        raise KeyboardInterrupt  # before the row that says so
+        yield
+
+    monkeypatch.setattr(batch, "_execute", killed_after_the_rename)
+    with pytest.raises(KeyboardInterrupt):
+        batch.run_batch(jobs, out, Settings())
+    rows = json.loads((out / "manifest.json").read_text())
+    assert [r["status"] for r in rows] == ["started"]
+    monkeypatch.undo()
+    (row,) = batch.run_batch(jobs, out, Settings())
+    assert "not from a batch" not in row["error"]  # done again, not taken for a stranger's
