@@ -86,3 +86,15 @@ def encoder_args(codec: str, crf: int | None, preset: str) -> list[str]:
     """FFmpeg's arguments for ``codec`` at quality ``crf`` (None: the codec's default)."""
     quality = DEFAULT_CRF.get(codec, 18) if crf is None else crf
     return ["-c:v", codec, *ENCODERS.get(codec, _x26x)(quality, preset)]
+
+
+def unused_quality(codec: str, crf: int | None) -> tuple[str, ...]:
+    """A notice where ``--crf`` was given for an encoder with no quality to set: PNG and
+    TIFF keep every sample, a GIF's palette is its quality (``--crf`` was ignored
+    silently)."""
+    make = ENCODERS.get(codec, _x26x)
+    if crf is None or make(0, "medium") != make(63, "medium"):
+        return ()
+    why = "it keeps every sample" if make is _lossless else "its palette is its quality"
+    return (f"--crf {crf} has no effect on {codec}: {why}",)
+

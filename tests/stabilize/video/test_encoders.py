@@ -1,0 +1,32 @@
+"""Each encoder's quality and speed: --crf and --preset on its own scale."""
+
+import pytest
+
+from stabilize.video.encoders import encoder_args, unused_quality
+
+
+def test_each_encoder_takes_the_quality_on_its_own_scale():
+    assert encoder_args("libx264", None, "medium") == [
+        "-c:v", "libx264", "-crf", "18", "-preset", "medium",
+    ]  # fmt: skip
+    assert encoder_args("libvpx-vp9", None, "veryslow")[2:4] == ["-crf", "31"]
+    assert "-cpu-used" in encoder_args("libvpx-vp9", 20, "ultrafast")
+    assert encoder_args("mjpeg", 18, "medium")[2:] == ["-q:v", "2"]  # the usual best
+    assert encoder_args("mpeg2video", 1000, "medium")[2:] == ["-q:v", "31"]  # at most 31
+    assert encoder_args("png", 10, "medium") == ["-c:v", "png"]
+
+
+@pytest.mark.parametrize(
+    ("codec", "crf", "heard"),
+    [
+        ("png", 10, "--crf 10 has no effect on png: it keeps every sample"),
+        ("tiff", 0, "--crf 0 has no effect on tiff: it keeps every sample"),
+        ("gif", 30, "--crf 30 has no effect on gif: its palette is its quality"),
+        ("png", None, None),  # not given: nothing to say
+        ("libx264", 23, None),
+        ("mjpeg", 23, None),
+        ("some-new-encoder", 23, None),  # gets -crf as it is
+    ],
+)
+def test_a_crf_with_no_effect_is_said(codec, crf, heard):
+    assert unused_quality(codec, crf) == ((heard,) if heard else ())
