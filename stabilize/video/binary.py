@@ -1,4 +1,4 @@
-"""Locating FFmpeg, and widening the pipes to it.
+"""Locating FFmpeg, widening the pipes to it, and reading what it says as it works.
 
 FFmpeg is the one on PATH, else the static binary shipped in the ``imageio-ffmpeg``
 wheel, so a fresh machine needs no system package.
@@ -10,7 +10,9 @@ import functools
 import os
 import shutil
 import subprocess
-from collections.abc import Sequence
+import threading
+from collections import deque
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from stabilize.video.sequence import image2_path
@@ -41,6 +43,7 @@ def local(path: str | Path, image2: bool = False) -> str:
 
 
 PIPE_BYTES = 1 << 20  # Linux's default ceiling for an unprivileged pipe
+KEPT_LINES = 50  # of a child's messages, the first and the last this many
 
 
 def widen_pipe(stream) -> None:
@@ -63,3 +66,29 @@ def filter_log(
     cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *before, "-i", local(path, "image2" in before)]
     cmd += ["-map", "0:v:0", "-vf", chain, *after, "-f", "null", "-"]
     return subprocess.run(cmd, capture_output=True, text=True, errors="replace").stderr
+
+
+def drain(stream, keep: int = KEPT_LINES) -> Callable[[], str]:
+    """Read a child's stderr as it comes, on a thread of its own; the function returned
+    waits for its end and gives its first and last ``keep`` lines.
+
+    A child writing more than the pipe holds while we read only its frames blocks for
+    ever: a damaged 60 s clip's decoding errors (200 kB) stopped FFmpeg, and the job
+    with it, where this reads them away as they come.
+    """
+    head: list[bytes] = []
+    tail: deque[bytes] = deque(maxlen=keep)
+
+    def read() -> None:
+        with stream:
+            for line in stream:
+                (head if len(head) < keep else tail).append(line)
+
+    thread = threading.Thread(target=read, daemon=True)
+    thread.start()
+
+    def said() -> str:
+        thread.join()
+        return b"".join([*head, *tail]).decode(errors="replace").strip()
+
+    return said

@@ -12,7 +12,7 @@ import ffmpeg
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.video.binary import ffmpeg_exe, local, widen_pipe
+from stabilize.video.binary import drain, ffmpeg_exe, local, widen_pipe
 from stabilize.video.fields import deinterlace_filter, interlaced
 from stabilize.video.i420 import pipe_layout
 from stabilize.video.probe import VideoError, VideoInfo, probe
@@ -86,6 +86,7 @@ def read_frames(
         .run_async(cmd=ffmpeg_exe(), pipe_stdout=True, pipe_stderr=True)
     )
     widen_pipe(process.stdout)
+    said = drain(process.stderr)
     shape, dtype = pipe_layout(pix_fmt, (h, w))
     frame_bytes = int(np.prod(shape)) * np.dtype(dtype).itemsize
     try:
@@ -96,7 +97,7 @@ def read_frames(
             yield np.frombuffer(buf, dtype).reshape(shape)
     finally:
         process.stdout.close()
-        err = process.stderr.read().decode(errors="replace").strip()
+        err = said()
         code = process.wait()
     if code != 0:
         last = err.splitlines()[-1] if err else f"exit status {code}"

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.video.binary import ffmpeg_exe, local, widen_pipe
+from stabilize.video.binary import drain, ffmpeg_exe, local, widen_pipe
 from stabilize.video.colour import UNKNOWN, Colour
 from stabilize.video.containers import Container, container_for
 from stabilize.video.encoders import FRAME_CLOCKED, encoder_args
@@ -162,6 +162,7 @@ class FrameWriter:
         cmd += [*output_args(path, encoding, container, mux.video_delay), *colour.ffmpeg_args()]
         cmd += [*colour.hdr10_args(codec), local(path, container.pictures is not None)]
         self._process = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+        self._said = drain(self._process.stderr)  # (a damaged source's audio says much)
         widen_pipe(self._process.stdin)
 
     def write(self, frame: NDArray[np.uint8]) -> None:
@@ -180,12 +181,12 @@ class FrameWriter:
             pass
         if self._process.wait() != 0:
             raise self._failure()
-        self._process.stderr.close()
+        self._said()
 
     def _failure(self) -> EncodeError:
         """The encoder's death as one line: its last message, the disk's state named."""
         self._process.kill()
-        err = self._process.stderr.read().decode(errors="replace").strip()
+        err = self._said()
         self._process.wait()
         return EncodeError(encoder_message(err, self._process.returncode))
 

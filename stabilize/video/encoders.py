@@ -97,4 +97,3 @@ def unused_quality(codec: str, crf: int | None) -> tuple[str, ...]:
         return ()
     why = "it keeps every sample" if make is _lossless else "its palette is its quality"
     return (f"--crf {crf} has no effect on {codec}: {why}",)
-
