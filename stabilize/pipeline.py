@@ -32,7 +32,7 @@ from rotation import so3
 from rotation.camera import intrinsics
 from rotation.hough import warm_up
 from stabilize.gyro.log import GyroLog
-from stabilize.motion.estimate import READOUT_BANDS
+from stabilize.motion.estimate import READOUT_BANDS, Damaged
 from stabilize.motion.focal import estimate_motion
 from stabilize.motion.repair import repair_unreliable
 from stabilize.motion.residual import reexpress
@@ -115,7 +115,15 @@ def stabilize_video(
         tell(notice)
     start = time.perf_counter()
     bar = progress or (lambda label, total: no_progress)
-    track, focal, rotations = _motion(src, job, settings, bar, tell)
+    try:
+        track, focal, rotations = _motion(src, job, settings, bar, tell)
+    except Damaged as damage:  # refused before, however few frames were lost
+        job = _decoded_only(src, job, damage)
+        tell(
+            f"damaged: {damage.listed - damage.decoded} of {damage.listed} frames do not "
+            f"decode; the {damage.decoded} that do are stabilised, each at its own time"
+        )
+        track, focal, rotations = _motion(src, job, settings, bar, tell)
     R, rolling, residual, repaired, gyro_summary, shutter, eased = rotations
     t_estimate = time.perf_counter() - start
     K = _camera_matrix(focal.px, job.info, job.lens)
@@ -218,6 +226,21 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
             "cropped (4:2:0 video needs even sides)",
         )
     return Job(info, times, lens, log, stamps, mux, encoding, notices)
+
+
+def _decoded_only(src: Path, job: Job, damage: Damaged) -> Job:
+    """``job`` with the times of the frames that decode, of a clip that lists more (a
+    damaged stream's, a recovered file's); ``damage`` again where a sensor log's frame
+    times (which count every frame) are used, or where the frames with times are not
+    those pass 1 read."""
+    if job.stamps is not None:
+        raise damage
+    times = frame_times(src, job.info.input_args, decoded=True)
+    if job.info.fields:
+        times = field_times(times)
+    if abs(len(times) - damage.decoded) > 1:  # (a container may list one extra)
+        raise damage
+    return replace(job, times=times)
 
 
 def encoder_notice(encoding: Encoding, default: str) -> tuple[str, ...]:

@@ -115,14 +115,23 @@ def estimate_rotations(
     if n < 2:
         raise VideoError(f"{path}: fewer than two frames decoded; nothing to stabilise")
     if n < len(times) - 1:
-        raise VideoError(
-            f"{path}: truncated or damaged: the container lists {len(times)} frames, "
-            f"only {n} decode"
-        )
+        raise Damaged(path, len(times), n)
     if len(times) != n:  # a frame's worth of slack for containers that list one extra
         times = times[:n] if len(times) > n else np.arange(n) / max(info.fps, 1.0)
     samples = _samples(kept, estimator, ws) if kept else None
     return replace(_track(times, found, voted), samples=samples, residual=np.concatenate(residual))
+
+
+class Damaged(VideoError):
+    """A clip of which fewer frames decode than its container lists (``listed``,
+    ``decoded``): damaged, or truncated."""
+
+    def __init__(self, path: str | Path, listed: int, decoded: int) -> None:
+        super().__init__(
+            f"{path}: truncated or damaged: the container lists {listed} frames, "
+            f"only {decoded} decode"
+        )
+        self.listed, self.decoded = listed, decoded
 
 
 @dataclass(frozen=True)

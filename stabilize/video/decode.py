@@ -119,15 +119,16 @@ def _discarded(row: list[str]) -> bool:
     return bool(int(flags, 16) & DISCARD)
 
 
-def frame_times(path: str | Path, input_args: tuple = ()) -> np.ndarray:
+def frame_times(path: str | Path, input_args: tuple = (), *, decoded: bool = False) -> np.ndarray:
     """Presentation times (s) of every video frame, from the first, in display order.
 
     Read from the container's packets (no decoding), so variable frame rate is exact.
     Where the packets carry no timestamps (AVI's MPEG-4 ASP, whose packets have only a
-    decoding order), the frames are decoded, cheaply (no pixels leave FFmpeg), and their
-    own times are taken instead.
+    decoding order), or with ``decoded`` (a damaged clip: the times of the frames that
+    do decode, :func:`read_frames`' frames), the frames are decoded, cheaply (no pixels
+    leave FFmpeg), and their own times are taken instead.
     """
-    times = _framecrc_times(path, input_args, decode=False)
+    times = None if decoded else _framecrc_times(path, input_args, decode=False)
     if times is None:
         times = _framecrc_times(path, input_args, decode=True)
     if times is None:

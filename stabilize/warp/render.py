@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
-from stabilize.video import FrameWriter, VideoInfo, i420, read_frames
+from stabilize.video import FrameWriter, VideoError, VideoInfo, i420, read_frames
 from stabilize.video.bars import put_back
 from stabilize.video.containers import Container, container_for
 from stabilize.video.encode import Encoding, Mux
@@ -97,6 +97,10 @@ def render(
                     writer.write(side_by_side(shown(frame), warped) if settings.preview else warped)
                     written += 1
                     progress(1)
+            if written < len(planned.times) - 1:  # the frames after a gap would slip in time
+                raise VideoError(
+                    f"{path}: {written} frames decoded, where pass 1 read {len(planned.times)}"
+                )
         if variable:
             retime(target, out, planned.times[:written], container.muxer, mux.video_delay)
     finally:

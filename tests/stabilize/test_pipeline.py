@@ -322,3 +322,24 @@ def test_colour_finer_than_4_2_0_halved_on_the_way_is_said(shaky, tmp_path, pix_
     said = [n for n in summary["notices"] if "halved to 4:2:0" in n]
     assert said == ([f"the source's 4:2:2 colour ({pix_fmt}) is halved to 4:2:0: the frames "
                      "travel to the encoder as 4:2:0"] if halved else [])  # fmt: skip
+
+
+def test_a_damaged_clip_is_stabilised_from_the_frames_that_decode(shaky, tmp_path):
+    # a stretch of the video's packets damaged (a failing card, a broken stream): it was
+    # refused ("the container lists 60 frames, only 42 decode")
+    ts, out = tmp_path / "damaged.ts", tmp_path / "out.mp4"
+    encode = ["-c:v", "libx264", "-g", "10", "-c:a", "aac"]
+    subprocess.run([ffmpeg_exe(), "-v", "error", "-i", str(shaky), *encode, str(ts)], check=True)
+    data = bytearray(ts.read_bytes())
+    for k in range(len(data) // 188 * 3 // 10, len(data) // 188 * 6 // 10):
+        p = 188 * k
+        if data[p + 1] & 0x1F == 0x01 and data[p + 2] == 0x00:  # the video's PID, 0x100
+            data[p + 30 : p + 188 : 7] = bytes(b ^ 0xFF for b in data[p + 30 : p + 188 : 7])
+    ts.write_bytes(bytes(data))
+    decoded = frame_times(ts, decoded=True)
+    assert len(decoded) < len(frame_times(ts)) - 1
+    heard: list[str] = []
+    summary, _ = stabilize_video(ts, out, Settings(fov=70.0), notify=heard.append)
+    assert summary["frames"] == len(decoded) and probe(out).has_audio
+    np.testing.assert_allclose(frame_times(out), decoded, atol=1e-3)  # each at its own time
+    assert any(line.startswith("damaged: ") for line in heard)
