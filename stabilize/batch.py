@@ -18,8 +18,9 @@ import json
 import multiprocessing as mp
 import os
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Generator, Iterator
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -30,6 +31,8 @@ from stabilize.video.atomic import sweep_stale
 MANIFEST = "manifest.json"
 BYTES_PER_WORKER = 1.5 * 2**30  # the pipeline's peak at 1080p, with headroom
 FRAME_REPORT = 10  # frames a worker counts before it reports them
+# a file whose worker died, done again alone, and died again
+WORKER_DIED = "its worker process stopped abruptly, running it alone (killed: out of memory?)"
 THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")
 
 
@@ -366,27 +369,51 @@ def _foreign(job: Job) -> dict:
 def _execute(
     jobs: list[Job], settings, workers: int, on_frames: Callable[[int], None] | None
 ) -> Iterator[dict]:
+    """The jobs' rows as they finish: in this process with one worker, else in a pool
+    of worker processes. A worker that dies (the kernel's out-of-memory killer's usual
+    victim) broke the pool, and the batch ended with it, every file in flight lost: the
+    files it left unfinished are done again one at a time, and one whose worker dies
+    with it alone fails."""
     on_frames = on_frames or (lambda n: None)
     if workers <= 1 or len(jobs) <= 1:
         for job in jobs:
             yield run_job(job, settings, on_frames)
         return
+    while jobs:
+        unfinished = yield from _pooled(jobs, settings, workers, on_frames)
+        if unfinished and workers == 1:  # alone, and in order: the first was running
+            yield job_row(unfinished[0], status="failed", error=WORKER_DIED, seconds=0.0)
+            unfinished = unfinished[1:]
+        jobs, workers = unfinished, 1
+
+
+def _pooled(
+    jobs: list[Job], settings, workers: int, on_frames: Callable[[int], None]
+) -> Generator[dict, None, list[Job]]:
+    """The rows of ``jobs`` run by ``workers`` processes, as they finish; returns the
+    jobs a dead worker left unfinished (in ``jobs``' order), none if none died."""
     threads = max(1, (os.cpu_count() or 1) // workers)
     settings = replace(settings, encoding=replace(settings.encoding, threads=threads))
     context = mp.get_context("spawn")  # clean workers: no inherited threads or locks
     frames = context.SimpleQueue()
+    unfinished: list[Job] = []
     with ProcessPoolExecutor(
         workers, mp_context=context, initializer=_start_worker, initargs=(threads, frames)
     ) as pool:
-        pending = {pool.submit(run_job, job, settings) for job in jobs}
+        futures = {pool.submit(run_job, job, settings): job for job in jobs}
+        pending = set(futures)
         while pending:
             finished, pending = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
             while not frames.empty():
                 on_frames(frames.get())
             for future in finished:
-                yield future.result()
+                if isinstance(future.exception(), BrokenProcessPool):
+                    unfinished.append(futures[future])
+                else:
+                    yield future.result()
         while not frames.empty():
             on_frames(frames.get())
+    return sorted(unfinished, key=jobs.index)
 
 
 def _execute_ray(jobs: list[Job], settings, address: str) -> Iterator[dict]:
@@ -406,10 +433,16 @@ def _execute_ray(jobs: list[Job], settings, address: str) -> Iterator[dict]:
     single = dict.fromkeys(THREAD_VARS, "1")
     task = ray.remote(num_cpus=1, runtime_env={"env_vars": single})(run_job)
     settings = replace(settings, encoding=replace(settings.encoding, threads=1))
-    pending = [task.remote(job, settings) for job in jobs]
+    tasks = {task.remote(job, settings): job for job in jobs}
+    pending = list(tasks)
     while pending:
-        ready, pending = ray.wait(pending, num_returns=1)
-        yield ray.get(ready[0])
+        (ready,), pending = ray.wait(pending, num_returns=1)
+        try:
+            row = ray.get(ready)
+        except Exception as err:  # its worker died (out of memory), or its node did
+            message = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+            row = job_row(tasks[ready], status="failed", error=f"its Ray task failed: {message}")
+        yield row
 
 
 __all__ = ["CLIP_SUFFIXES", "Job", "find_jobs", "load_manifest", "run_batch"]

@@ -220,3 +220,31 @@ def test_an_output_a_killed_run_wrote_is_still_its_own(folder, tmp_path, monkeyp
     monkeypatch.undo()
     (row,) = batch.run_batch(jobs, out, Settings())
     assert "not from a batch" not in row["error"]  # done again, not taken for a stranger's
+
+
+def test_a_worker_that_dies_costs_its_file_alone(folder, tmp_path):
+    # a worker killed (the out-of-memory killer's way) broke the pool: the batch ended,
+    # "A process in the process pool was terminated abruptly", every file in flight lost
+    import multiprocessing as mp
+
+    import stabilize.batch as batch
+    from stabilize import Settings
+
+    for name in ("b.mp4", "c.mp4"):
+        (folder / name).write_bytes(SAMPLE.read_bytes())
+    jobs = find_jobs(folder, tmp_path / "out", "[abc].mp4")
+    kills: list[int] = []
+    seen: set[int] = set()  # the pool's workers at a kill: the next kill is in a new pool
+
+    def kill_a_worker(_frames: int) -> None:  # in the pool, then again when alone
+        workers = [w for w in mp.active_children() if w.pid not in seen]
+        if len(kills) < 2 and workers:
+            seen.update(w.pid for w in mp.active_children())
+            os.kill(workers[0].pid, signal.SIGKILL)
+            kills.append(workers[0].pid)
+
+    rows = list(batch._execute(jobs, Settings(), 2, kill_a_worker))
+    assert len(kills) == 2 and sorted(r["input"] for r in rows) == ["a.mp4", "b.mp4", "c.mp4"]
+    failed = [r for r in rows if r["status"] == "failed"]
+    assert len(failed) == 1 and failed[0]["error"] == batch.WORKER_DIED
+    assert all(Path(r["output"]).is_file() for r in rows if r["status"] == "done")
