@@ -30,10 +30,18 @@ TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 RATE_UNITS = {"rad/s": 1.0, "deg/s": np.pi / 180.0}
 
 
+def _check_file(path: Path) -> None:
+    """A GyroError where ``path`` is no file to read: missing, or a pipe (``<(cat log)``),
+    which the log's readers would read more than once."""
+    if not path.exists():
+        raise GyroError(f"{path}: no such gyro log")
+    if not path.is_file():
+        raise GyroError(f"{path}: is a pipe, a device or a folder, not a file: save the log first")
+
+
 def _rows(path: Path, n_fields: int, *, start: int = 0) -> list[list[float]]:
     """Numeric CSV rows from line ``start`` on, or a GyroError naming the first bad line."""
-    if not path.is_file():
-        raise GyroError(f"{path}: no such gyro log")
+    _check_file(path)
     rows = []
     with open(path, errors="replace") as f:
         for number, line in enumerate(f, start=1):
@@ -118,8 +126,7 @@ def read_gcsv(path: str | Path) -> GyroLog:
     lower-case letter meaning the negative axis; rates are returned in sensor axes.
     """
     path = Path(path)
-    if not path.is_file():
-        raise GyroError(f"{path}: no such gyro log")
+    _check_file(path)
     header: dict[str, str] = {}
     columns: list[str] = []
     with open(path, errors="replace") as f:
@@ -206,8 +213,7 @@ def read_named_csv(
     as a spreadsheet in many languages writes them.
     """
     path = Path(path)
-    if not path.is_file():
-        raise GyroError(f"{path}: no such gyro log")
+    _check_file(path)
     with open(path, newline="", encoding="utf-8-sig", errors="replace") as f:
         header = f.readline()
         delimiter = _delimiter(header)
@@ -293,8 +299,7 @@ def detect_format(path: str | Path) -> str:
     path = Path(path)
     if path.suffix.lower() in VIDEO_SUFFIXES:
         return "telemetry"
-    if not path.is_file():
-        raise GyroError(f"{path}: no such gyro log")
+    _check_file(path)
     with open(path, errors="replace") as f:
         first = f.readline().strip()
     if not first:

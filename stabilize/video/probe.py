@@ -254,6 +254,10 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
         raise VideoError(gap)
     if path.is_dir():
         raise VideoError(f"{path}: is a folder, not a video (give a pattern like dir/img-%d.jpg)")
+    if not pattern and not path.is_file():
+        # a pipe (<(curl ...), a FIFO) is read once, where a clip is read in two passes:
+        # a FIFO with no writer waited for ever, a process substitution read "not a video"
+        raise VideoError(f"{path}: is a pipe or a device, not a file: save the clip first")
     result = subprocess.run(
         [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i", local(path, pattern)],
         capture_output=True,

@@ -3,6 +3,8 @@ axis letters and the gyro formats explained."""
 
 from __future__ import annotations
 
+import os
+
 import pytest
 from typer.testing import CliRunner
 
@@ -57,3 +59,18 @@ def test_quiet_may_come_first(monkeypatch, capsys):
         main()
     assert done.value.code == 2
     assert capsys.readouterr().err.strip() == "error: nope.mp4: no such file"
+
+
+def test_a_pipe_for_the_clip_is_refused_before_it_waits(tmp_path, monkeypatch, capsys):
+    # a clip is read in two passes: a FIFO with no writer waited for ever, and a process
+    # substitution, <(curl ...), read "not a video FFmpeg can read"
+    os.mkfifo(tmp_path / "piped.mp4")
+    monkeypatch.setattr("sys.argv", ["stabilize", str(tmp_path / "piped.mp4"), "out.mp4"])
+    with pytest.raises(SystemExit) as done:
+        main()
+    assert done.value.code == 2
+    assert (
+        capsys.readouterr()
+        .err.strip()
+        .endswith("is a pipe or a device, not a file: save the clip first")
+    )

@@ -1,5 +1,7 @@
 """Each reader on small fixture files written here, and the errors for bad logs."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -140,3 +142,7 @@ def test_bad_logs_name_the_line_and_problem(tmp_path, name, text, message):
 def test_unreadable_log(tmp_path):
     with pytest.raises(GyroError, match="no such gyro log"):
         read_gyro(tmp_path / "missing.csv")
+    os.mkfifo(tmp_path / "piped.csv")  # a log read more than once: <(cat log) read "no such"
+    for where in (tmp_path / "piped.csv", tmp_path):
+        with pytest.raises(GyroError, match="not a file: save the log first"):
+            read_gyro(where)
