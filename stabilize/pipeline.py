@@ -118,11 +118,10 @@ def stabilize_video(
     try:
         track, focal, rotations = _motion(src, job, settings, bar, tell)
     except Damaged as damage:  # refused before, however few frames were lost
-        job = _decoded_only(src, job, damage)
-        tell(
-            f"damaged: {damage.listed - damage.decoded} of {damage.listed} frames do not "
-            f"decode; the {damage.decoded} that do are stabilised, each at its own time"
-        )
+        if job.stamps is not None:  # a sensor log's frame times count every frame
+            raise
+        job = replace(job, times=damage.frames_that_decode(job.info))
+        tell(damage.notice)
         track, focal, rotations = _motion(src, job, settings, bar, tell)
     R, rolling, residual, repaired, gyro_summary, shutter, eased = rotations
     t_estimate = time.perf_counter() - start
@@ -226,21 +225,6 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
             "cropped (4:2:0 video needs even sides)",
         )
     return Job(info, times, lens, log, stamps, mux, encoding, notices)
-
-
-def _decoded_only(src: Path, job: Job, damage: Damaged) -> Job:
-    """``job`` with the times of the frames that decode, of a clip that lists more (a
-    damaged stream's, a recovered file's); ``damage`` again where a sensor log's frame
-    times (which count every frame) are used, or where the frames with times are not
-    those pass 1 read."""
-    if job.stamps is not None:
-        raise damage
-    times = frame_times(src, job.info.input_args, decoded=True)
-    if job.info.fields:
-        times = field_times(times)
-    if abs(len(times) - damage.decoded) > 1:  # (a container may list one extra)
-        raise damage
-    return replace(job, times=times)
 
 
 def encoder_notice(encoding: Encoding, default: str) -> tuple[str, ...]:

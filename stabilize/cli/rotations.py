@@ -54,6 +54,7 @@ def rotations(
     upright records, is read unturned)."""
     from rotation import so3
     from stabilize.cli.bars import with_bars
+    from stabilize.motion.estimate import Damaged
     from stabilize.motion.files import write_rotations
     from stabilize.motion.focal import estimate_motion
     from stabilize.video import atomic_output, probe, sequence_args
@@ -74,7 +75,12 @@ def rotations(
     info = run_or_fail(lambda: probe(input_path, sequence_args(input_path, fps=fps)).stored())
 
     def estimate(bar):
-        return estimate_motion(input_path, info, settings, bar("estimating", None))
+        try:
+            return estimate_motion(input_path, info, settings, bar("estimating", None))
+        except Damaged as damage:  # the frames that decode, each at its own time
+            times = damage.frames_that_decode(info)
+            notice(damage.notice)
+            return estimate_motion(input_path, info, settings, bar("estimating", None), times)
 
     announce_compiling()
     track, focal = run_or_fail(lambda: with_bars(estimate, quiet=quiet))

@@ -42,6 +42,7 @@ from stabilize.motion.track import Samples, VisualTrack, mean_rows
 from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
 from stabilize.video import VideoError, VideoInfo, frame_times, read_frames
+from stabilize.video.fields import field_times
 from stabilize.warp.lens import Lens, pinhole_map
 
 ESTIMATE_CHUNK = 32  # flow fields held at once in pass 1
@@ -124,14 +125,31 @@ def estimate_rotations(
 
 class Damaged(VideoError):
     """A clip of which fewer frames decode than its container lists (``listed``,
-    ``decoded``): damaged, or truncated."""
+    ``decoded``): damaged (a failing card, a broken stream), or truncated."""
 
     def __init__(self, path: str | Path, listed: int, decoded: int) -> None:
         super().__init__(
             f"{path}: truncated or damaged: the container lists {listed} frames, "
             f"only {decoded} decode"
         )
-        self.listed, self.decoded = listed, decoded
+        self.path, self.listed, self.decoded = path, listed, decoded
+
+    def frames_that_decode(self, info: VideoInfo) -> NDArray:
+        """The times of the frames that do decode (each field's, where each is a
+        frame), to run pass 1 again with; this error again where they are not the
+        frames pass 1 read."""
+        times = frame_times(self.path, info.input_args, decoded=True)
+        times = field_times(times) if info.fields else times
+        if abs(len(times) - self.decoded) > 1:  # (a container may list one extra)
+            raise self
+        return times
+
+    @property
+    def notice(self) -> str:
+        return (
+            f"damaged: {self.listed - self.decoded} of {self.listed} frames do not decode; "
+            f"the {self.decoded} that do are used, each at its own time"
+        )
 
 
 @dataclass(frozen=True)

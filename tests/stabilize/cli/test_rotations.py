@@ -3,7 +3,8 @@
 from typer.testing import CliRunner
 
 from stabilize.cli import app
-from tests.stabilize.helpers import held_upright
+from stabilize.video import frame_times
+from tests.stabilize.helpers import damaged, held_upright
 
 
 def test_rotations_command(shaky, tmp_path):
@@ -12,6 +13,16 @@ def test_rotations_command(shaky, tmp_path):
     assert result.exit_code == 0, result.output
     lines = out.read_text().splitlines()
     assert lines[0] == "frame,t,rx,ry,rz,support" and len(lines) == 60
+
+
+def test_a_damaged_clip_gives_the_rotations_of_the_frames_that_decode(shaky, tmp_path):
+    out = tmp_path / "rot.csv"
+    args = ["rotations", str(damaged(shaky, tmp_path)), "-o", str(out), "--fov", "70"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output  # it was refused, as damaged
+    decoded = len(frame_times(tmp_path / "damaged.ts", decoded=True))
+    assert f"the {decoded} that do are used" in result.output
+    assert len(out.read_text().splitlines()) == decoded  # the header, and a row a pair
 
 
 def test_a_clip_held_upright_gives_its_sensors_rotations(shaky, tmp_path):
