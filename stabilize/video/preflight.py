@@ -60,12 +60,27 @@ def check_encoder(path: str | Path, encoding: Encoding, size: tuple[int, int]) -
         cmd += [*output_args(out, encoding, container), str(out)]
         result = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
     if result.returncode != 0:
-        first = (result.stderr.strip().splitlines() or ["exit status " + str(result.returncode)])[0]
-        codec = encoding.codec_for(container)
-        raise OutputError(
-            f"FFmpeg cannot write {codec} (preset {encoding.preset}) as "
-            f"{Path(path).suffix or 'this file'}: {first}"
-        )
+        raise OutputError(_cannot_write(Path(path), encoding, result.stderr, result.returncode))
+
+
+# FFmpeg's words where the suffix names no muxer, and where its muxer holds no video
+NO_MUXER, NO_VIDEO = "Unable to choose an output format", "does not contain any stream"
+SOME_CONTAINERS = ".mp4, .mov, .mkv, .webm"
+
+
+def _cannot_write(path: Path, encoding: Encoding, stderr: str, code: int) -> str:
+    """Why FFmpeg cannot write ``path`` with ``encoding``: the suffix named in the
+    user's words where it names no video container (the check's own file was named,
+    ``/tmp/stabilize-check.y29r5892/check.xyz``), else FFmpeg's first complaint."""
+    if NO_MUXER in stderr and not path.suffix:
+        return f"{path}: no suffix names its container: give {SOME_CONTAINERS}, … ({path}.mp4)"
+    if NO_MUXER in stderr:
+        return f"{path}: {path.suffix} names no container FFmpeg writes: give {SOME_CONTAINERS}, …"
+    if NO_VIDEO in stderr:
+        return f"{path}: {path.suffix} holds no video (audio only): give {SOME_CONTAINERS}, …"
+    first = (stderr.strip().splitlines() or [f"exit status {code}"])[0]
+    codec = encoding.codec_for(container_for(path))
+    return f"FFmpeg cannot write {codec} (preset {encoding.preset}) as {path.suffix}: {first}"
 
 
 def describe(err: OSError) -> str:

@@ -266,6 +266,8 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     )
     text = result.stderr
     video = _VIDEO.search(text)
+    if video is None and re.search(r"Stream #\S+.*?: Audio: ", text):
+        raise VideoError(f"{path}: has no video stream, only audio")
     if video is None:
         raise VideoError(f"{path}: not a video FFmpeg can read")
     codec, pix_fmt, w, h = video.group(1), video.group(2), int(video.group(4)), int(video.group(5))
