@@ -53,7 +53,7 @@ from stabilize.video.encode import EncodeError, Encoding, Mux
 from stabilize.video.encoders import unused_quality
 from stabilize.video.fields import DEINTERLACE_MODES, field_times
 from stabilize.video.i420 import chroma, pipe_format
-from stabilize.video.preflight import check_encoder, check_writable, describe
+from stabilize.video.preflight import check_encoder, check_streams, check_writable, describe
 from stabilize.video.sequence import (
     first_image,
     is_pattern,
@@ -209,6 +209,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     if settings.bars == "auto" and not settings.lens:
         info = info.within_bars(detect_bars(info))
     mux = keep_streams(info, container, info.video_delay)
+    check_streams(dst, encoding, encoded_size(info, settings), mux)
     notices = mux.notices + fields_notice(info) + pixels_notice(info) + bars_notice(info)
     if not container.timed:  # an image sequence: numbered as the input's, else from 1
         first = first_image(info.input_args)

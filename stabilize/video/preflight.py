@@ -8,11 +8,14 @@ import errno
 import os
 import subprocess
 import tempfile
+from dataclasses import replace
 from pathlib import Path
+
+import numpy as np
 
 from stabilize.video.binary import ffmpeg_exe
 from stabilize.video.containers import container_for
-from stabilize.video.encode import Encoding, output_args
+from stabilize.video.encode import EncodeError, Encoding, FrameWriter, Mux, output_args
 from stabilize.video.encoders import VIDEO_ONLY
 from stabilize.video.sequence import is_pattern
 
@@ -81,6 +84,28 @@ def _cannot_write(path: Path, encoding: Encoding, stderr: str, code: int) -> str
     first = (stderr.strip().splitlines() or [f"exit status {code}"])[0]
     codec = encoding.codec_for(container_for(path))
     return f"FFmpeg cannot write {codec} (preset {encoding.preset}) as {path.suffix}: {first}"
+
+
+def check_streams(path: str | Path, encoding: Encoding, size: tuple[int, int], mux: Mux) -> None:
+    """That FFmpeg writes the source's tracks, as ``mux`` keeps them, beside two frames of
+    (H, W) ``size`` into the container ``path``'s suffix names (a tenth of a second of
+    them): a track the container cannot hold failed only once the work was done (AAC
+    audio in MXF, "Codec 'aac' is not supported by the bitstream filter")."""
+    if not mux.inputs or not container_for(path).timed:  # pictures take no tracks
+        return
+    brief = replace(mux, args=(*mux.args, "-t", "0.1"))
+    with tempfile.TemporaryDirectory(prefix="stabilize-check.") as tmp:
+        out = Path(tmp) / f"check{Path(path).suffix}"
+        try:
+            with FrameWriter(out, size, 30.0, encoding, brief) as writer:
+                for _ in range(2):
+                    writer.write(np.zeros(writer.shape, writer.dtype))
+        except EncodeError as err:
+            reason = str(err).removeprefix("the encoder failed: ")
+            raise OutputError(
+                f"{Path(path)}: the source's tracks cannot go into {Path(path).suffix} as "
+                f"they are (FFmpeg: {reason}); another container, e.g. .mkv, takes them"
+            ) from None
 
 
 def describe(err: OSError) -> str:

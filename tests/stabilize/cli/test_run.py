@@ -75,7 +75,7 @@ def test_one_and_zero_frame_videos(shaky, tmp_path):
     result = RUNNER.invoke(app, ["run", str(one), str(tmp_path / "o1.mp4"), "-q"])
     assert result.exit_code != 0 and "1 frame" in result.output
     result = RUNNER.invoke(app, ["run", str(silent), str(tmp_path / "o2.mp4"), "-q"])
-    assert result.exit_code != 0 and "not a video" in result.output
+    assert result.exit_code != 0 and "has no video stream, only audio" in result.output
     assert not (tmp_path / "o1.mp4").exists() and not (tmp_path / "o2.mp4").exists()
 
 
