@@ -126,6 +126,15 @@ GIF_PALETTE = (
     "split[a][b];[a]palettegen=stats_mode=single[p];[b][p]paletteuse=new=1:dither=sierra2_4a"
 )
 
+MPEG_TS = Container(
+    "mpegts",
+    audio=frozenset({"aac", "mp3", "mp2", "ac3", "eac3", "opus"}),
+    subtitles=frozenset({"dvb_subtitle"}),
+    chapters=False,
+    deep_encoder="libx265",
+    name="MPEG-TS",
+)
+
 MPEG_PS = Container(
     "vob",
     "mpeg2video",
@@ -174,14 +183,12 @@ CONTAINERS: dict[str, Container] = {
         subtitles=frozenset(),
         chapters=False,
     ),
-    ".ts": Container(
-        "mpegts",
-        audio=frozenset({"aac", "mp3", "mp2", "ac3", "eac3", "opus"}),
-        subtitles=frozenset({"dvb_subtitle"}),
-        chapters=False,
-        deep_encoder="libx265",
-        name="MPEG-TS",
-    ),
+    ".ts": MPEG_TS,
+    # a camcorder's AVCHD (.MTS) and a Blu-ray's (.m2ts): MPEG-TS in 192-byte packets.
+    # FFmpeg took .mts for plain MPEG-TS and wrote a text subtitle into it as a data
+    # track no player reads, and refused one in .m2ts
+    ".mts": replace(MPEG_TS, options=("-mpegts_m2ts_mode", "1"), name="M2TS"),
+    ".m2ts": replace(MPEG_TS, options=("-mpegts_m2ts_mode", "1"), name="M2TS"),
     # OUT a pattern (frames/%05d.png): a picture per frame, at 16 bits a channel for a
     # source of 10 bits or more where the format holds them (PNG, TIFF)
     ".png": image_sequence("png", ("rgb24", "rgb48be")),

@@ -30,14 +30,22 @@ def is_variable_rate(times: NDArray, tolerance: float = 0.01) -> bool:
 
 
 def retime(
-    src: str | Path, dst: str | Path, times: NDArray, muxer: str = "", start: float = 0.0
+    src: str | Path,
+    dst: str | Path,
+    times: NDArray,
+    muxer: str = "",
+    start: float = 0.0,
+    options: tuple[str, ...] = (),
 ) -> None:
     """Copy ``src`` (written at a constant rate, without B-frames) to ``dst`` with the
     video frames stamped at ``times`` (s, one per frame); other streams are copied as they
     are. No re-encoding: the packets are remuxed with new timestamps.
 
     The first frame is stamped at ``start`` (s), where the source's video began after
-    its first stream. ``muxer`` names the output's format (empty: from its suffix). The
+    its first stream. ``muxer`` names the output's format (empty: from its suffix), and
+    ``options`` are its options as FFmpeg's command line takes them (``-movflags
+    +faststart+use_metadata_tags``: without them a phone's own tags, its location among
+    them, were lost from a variable-rate clip, and the index was written last). The
     file's metadata and chapters come along.
 
     FFmpeg's command line cannot take per-frame timestamps for frames arriving through a
@@ -51,7 +59,9 @@ def retime(
     ticks = np.maximum.accumulate(ticks - step) + step  # strictly rising, as a muxer needs
     last = np.median(np.diff(ticks)) if len(ticks) > 1 else TIMESCALE // 30
     gaps = np.diff(ticks, append=ticks[-1] + last)
-    with av.open(local(src)) as inp, av.open(local(dst), "w", format=muxer or None) as out:
+    named = {k.lstrip("-"): v for k, v in zip(options[::2], options[1::2], strict=True)}
+    written = av.open(local(dst), "w", format=muxer or None, container_options=named)
+    with av.open(local(src)) as inp, written as out:
         video = inp.streams.video[0]
         streams = {s.index: out.add_stream_from_template(s) for s in inp.streams}
         out.metadata.update(inp.metadata)

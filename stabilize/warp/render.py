@@ -102,7 +102,8 @@ def render(
                     f"{path}: {written} frames decoded, where pass 1 read {len(planned.times)}"
                 )
         if variable:
-            retime(target, out, planned.times[:written], container.muxer, mux.video_delay)
+            times = planned.times[:written]
+            retime(target, out, times, container.muxer, mux.video_delay, container.options)
     finally:
         if variable:
             target.unlink(missing_ok=True)

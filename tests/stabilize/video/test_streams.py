@@ -14,6 +14,7 @@ from stabilize import Settings, stabilize_video
 from stabilize.video import Encoding, FrameWriter, ffmpeg_exe, frame_times, probe, read_frames
 from stabilize.video.containers import container_for
 from stabilize.video.streams import keep_streams
+from tests.stabilize.helpers import SAMPLE
 
 SUBTITLES = {"eng": "Hello street", "fra": "Bonjour la rue"}
 CHAPTERS = ("Start", "Corner")
@@ -305,3 +306,38 @@ def test_a_gif_says_it_carries_alpha_only_where_it_declares_transparency(shaky, 
         ("bgra", False),
         ("bgra", True),
     ]
+
+
+def test_a_variable_rate_phone_clip_keeps_its_own_tags_and_plays_while_loading(tmp_path):
+    # a variable rate is remuxed with its own times, which wrote neither the phone's tags
+    # (its location among them) nor the index first
+    clip, out = tmp_path / "phone.mov", tmp_path / "out.mov"
+    tags = {
+        "com.apple.quicktime.location.ISO6709": "+48.8584+002.2945+035.000/",
+        "com.apple.quicktime.make": "Apple",
+    }
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(SAMPLE / "clip.mp4"), "-c:a", "copy"]
+    cmd += ["-vf", "setpts=(N+0.4*mod(N\\,3))/30/TB", "-enc_time_base:v", "1:90000"]
+    for key, value in tags.items():
+        cmd += ["-metadata", f"{key}={value}"]
+    subprocess.run([*cmd, "-movflags", "use_metadata_tags", str(clip)], check=True)
+    stabilize_video(clip, out, Settings(fov=70.0))
+    assert np.ptp(np.diff(frame_times(out))) > 0.01  # remuxed at its variable rate
+    with av.open(str(out)) as c:
+        assert tags.items() <= dict(c.metadata).items()
+    data = out.read_bytes()
+    assert data.find(b"moov") < data.find(b"mdat")  # the index first (+faststart)
+
+
+@pytest.mark.parametrize("suffix", [".mts", ".m2ts"])
+def test_avchd_and_blu_ray_suffixes_write_m2ts(rich, tmp_path, suffix):
+    # .mts was plain MPEG-TS with a text subtitle written as a data track no player reads,
+    # and .m2ts refused the subtitle ("Cannot automatically assign PID")
+    info, out = probe(rich["mp4"]), tmp_path / f"out{suffix}"
+    mux = keep_streams(info, container_for(out))
+    assert "left out subtitle #3 (mov_text): M2TS cannot hold it" in mux.notices
+    with FrameWriter(out, info.size, 30.0, Encoding(), mux) as writer:
+        for _ in range(3):
+            writer.write(np.zeros(writer.shape, writer.dtype))
+    data = out.read_bytes()
+    assert len(data) % 192 == 0 and data[4::192][:100] == b"\x47" * 100  # 192-byte packets
