@@ -68,6 +68,9 @@ def retime(
         for s in inp.streams:
             streams[s.index].metadata.update(s.metadata)
             streams[s.index].disposition = s.disposition  # which track plays by default
+            # the tag the same muxer chose (HEVC's hvc1, which Apple's players need, where
+            # this remux wrote hev1, which they do not play)
+            streams[s.index].codec_tag = s.codec_tag
         if inp.chapters():
             out.set_chapters(inp.chapters())
         streams[video.index].time_base = Fraction(1, TIMESCALE)
