@@ -63,20 +63,24 @@ def retime(
     written = av.open(local(dst), "w", format=muxer or None, container_options=named)
     with av.open(local(src)) as inp, written as out:
         video = inp.streams.video[0]
-        streams = {s.index: out.add_stream_from_template(s) for s in inp.streams}
+        # a timecode track the muxer writes again from the video's timecode tag: copied
+        # too, it failed the remux ("Invalid argument") once the work was done
+        kept = [s for s in inp.streams if not _rewritten_timecode(s, video)]
+        streams = {s.index: out.add_stream_from_template(s) for s in kept}
         out.metadata.update(inp.metadata)
-        for s in inp.streams:
+        for s in kept:
             streams[s.index].metadata.update(s.metadata)
             streams[s.index].disposition = s.disposition  # which track plays by default
             # the tag the same muxer chose (HEVC's hvc1, which Apple's players need, where
             # this remux wrote hev1, which they do not play)
-            streams[s.index].codec_tag = s.codec_tag
+            if s.type in ("video", "audio"):  # (a data stream has none to set)
+                streams[s.index].codec_tag = s.codec_tag
         if inp.chapters():
             out.set_chapters(inp.chapters())
         streams[video.index].time_base = Fraction(1, TIMESCALE)
         k = 0  # without B-frames, packets come in display order: the k-th is frame k
         for packet in inp.demux():
-            if packet.dts is None:  # a demuxer's flush packet
+            if packet.dts is None or packet.stream.index not in streams:  # a flush packet
                 continue
             if packet.stream is video:
                 if k >= len(ticks):
@@ -87,3 +91,9 @@ def retime(
                 k += 1
             packet.stream = streams[packet.stream.index]
             out.mux(packet)
+
+
+def _rewritten_timecode(stream, video) -> bool:
+    """Whether ``stream`` is a timecode track (QuickTime's tmcd: a data track with a
+    timecode) that the muxer writes again from the ``video``'s own timecode tag."""
+    return stream.type == "data" and "timecode" in stream.metadata and "timecode" in video.metadata

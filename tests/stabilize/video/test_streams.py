@@ -310,8 +310,8 @@ def test_a_gif_says_it_carries_alpha_only_where_it_declares_transparency(shaky, 
 
 def test_a_variable_rate_phone_clip_keeps_its_tags_and_plays_on_apples_players(tmp_path):
     # a variable rate is remuxed with its own times, which wrote neither the phone's tags
-    # (its location among them) nor the index first, and tagged HEVC hev1, which Apple's
-    # players do not play
+    # (its location among them) nor the index first, tagged HEVC hev1, which Apple's
+    # players do not play, and failed on a timecode track ("Invalid argument")
     clip, out = tmp_path / "phone.mov", tmp_path / "out.mov"
     tags = {
         "com.apple.quicktime.location.ISO6709": "+48.8584+002.2945+035.000/",
@@ -321,12 +321,15 @@ def test_a_variable_rate_phone_clip_keeps_its_tags_and_plays_on_apples_players(t
     cmd += ["-vf", "setpts=(N+0.4*mod(N\\,3))/30/TB", "-enc_time_base:v", "1:90000"]
     for key, value in tags.items():
         cmd += ["-metadata", f"{key}={value}"]
-    subprocess.run([*cmd, "-movflags", "use_metadata_tags", str(clip)], check=True)
+    cmd += ["-timecode", "01:02:03:04", "-movflags", "use_metadata_tags"]
+    subprocess.run([*cmd, str(clip)], check=True)
     stabilize_video(clip, out, Settings(fov=70.0, encoding=Encoding(codec="libx265")))
     assert np.ptp(np.diff(frame_times(out))) > 0.01  # remuxed at its variable rate
     with av.open(str(out)) as c:
         assert tags.items() <= dict(c.metadata).items()
         assert c.streams.video[0].codec_tag == "hvc1"
+        assert c.streams.video[0].metadata["timecode"] == "01:02:03:04"
+        assert [s.metadata.get("timecode") for s in c.streams.data] == ["01:02:03:04"]  # tmcd
     data = out.read_bytes()
     assert data.find(b"moov") < data.find(b"mdat")  # the index first (+faststart)
 
