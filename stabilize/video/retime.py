@@ -63,9 +63,11 @@ def retime(
     written = av.open(local(dst), "w", format=muxer or None, container_options=named)
     with av.open(local(src)) as inp, written as out:
         video = inp.streams.video[0]
-        # a timecode track the muxer writes again from the video's timecode tag: copied
-        # too, it failed the remux ("Invalid argument") once the work was done
-        kept = [s for s in inp.streams if not _rewritten_timecode(s, video)]
+        # the tracks the muxer writes again, from the video's timecode tag and from the
+        # chapter list: copied too, each failed the remux once the work was done
+        # ("Invalid argument", "Invalid data found when processing input")
+        chaptered = bool(inp.chapters())
+        kept = [s for s in inp.streams if not _rewritten(s, video, chaptered)]
         streams = {s.index: out.add_stream_from_template(s) for s in kept}
         out.metadata.update(inp.metadata)
         for s in kept:
@@ -93,7 +95,14 @@ def retime(
             out.mux(packet)
 
 
-def _rewritten_timecode(stream, video) -> bool:
-    """Whether ``stream`` is a timecode track (QuickTime's tmcd: a data track with a
-    timecode) that the muxer writes again from the ``video``'s own timecode tag."""
-    return stream.type == "data" and "timecode" in stream.metadata and "timecode" in video.metadata
+AVDISCARD_ALL = 48  # FFmpeg's mark on a track it reads nothing from: MP4's chapter track
+
+
+def _rewritten(stream, video, chaptered: bool) -> bool:
+    """Whether ``stream`` is a track the muxer writes again: a timecode track (QuickTime's
+    tmcd, a data track with a timecode) from the ``video``'s own timecode tag, or MP4's
+    chapter track (read as a data track FFmpeg takes nothing from) from the chapters."""
+    if stream.type != "data":
+        return False
+    timecode = "timecode" in stream.metadata and "timecode" in video.metadata
+    return timecode or (chaptered and stream.discard == AVDISCARD_ALL)

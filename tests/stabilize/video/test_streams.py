@@ -311,13 +311,20 @@ def test_a_gif_says_it_carries_alpha_only_where_it_declares_transparency(shaky, 
 def test_a_variable_rate_phone_clip_keeps_its_tags_and_plays_on_apples_players(tmp_path):
     # a variable rate is remuxed with its own times, which wrote neither the phone's tags
     # (its location among them) nor the index first, tagged HEVC hev1, which Apple's
-    # players do not play, and failed on a timecode track ("Invalid argument")
+    # players do not play, and failed on a timecode track ("Invalid argument") and on
+    # chapters ("Invalid data found when processing input")
     clip, out = tmp_path / "phone.mov", tmp_path / "out.mov"
+    chapters = tmp_path / "chapters.txt"
+    chapters.write_text(
+        ";FFMETADATA1\n[CHAPTER]\nTIMEBASE=1/1000\nSTART=0\nEND=1000\ntitle=Start\n"
+        "[CHAPTER]\nTIMEBASE=1/1000\nSTART=1000\nEND=2000\ntitle=Corner\n"
+    )
     tags = {
         "com.apple.quicktime.location.ISO6709": "+48.8584+002.2945+035.000/",
         "com.apple.quicktime.make": "Apple",
     }
-    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(SAMPLE / "clip.mp4"), "-c:a", "copy"]
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(SAMPLE / "clip.mp4"), "-i", str(chapters)]
+    cmd += ["-map", "0", "-map_chapters", "1", "-c:a", "copy"]
     cmd += ["-vf", "setpts=(N+0.4*mod(N\\,3))/30/TB", "-enc_time_base:v", "1:90000"]
     for key, value in tags.items():
         cmd += ["-metadata", f"{key}={value}"]
@@ -329,7 +336,9 @@ def test_a_variable_rate_phone_clip_keeps_its_tags_and_plays_on_apples_players(t
         assert tags.items() <= dict(c.metadata).items()
         assert c.streams.video[0].codec_tag == "hvc1"
         assert c.streams.video[0].metadata["timecode"] == "01:02:03:04"
-        assert [s.metadata.get("timecode") for s in c.streams.data] == ["01:02:03:04"]  # tmcd
+        timecodes = [s.metadata.get("timecode") for s in c.streams.data]
+        assert "01:02:03:04" in timecodes  # its tmcd track
+        assert [ch["metadata"]["title"] for ch in c.chapters()] == ["Start", "Corner"]
     data = out.read_bytes()
     assert data.find(b"moov") < data.find(b"mdat")  # the index first (+faststart)
 
