@@ -178,7 +178,9 @@ def write_manifest(out_dir: Path, rows: dict[str, dict]) -> None:
         "peak_mb",
     ]
     with atomic_output(out_dir / "manifest.csv", overwrite=True) as tmp:
-        with open(tmp, "w", newline="") as f:
+        # a name that is not UTF-8 (caf\xe9.mp4 off an old card) as its own bytes: it
+        # failed the batch ("surrogates not allowed"); the JSON escapes it
+        with open(tmp, "w", newline="", errors="surrogateescape") as f:
             writer = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
             writer.writeheader()
             writer.writerows(ordered)

@@ -149,11 +149,14 @@ def short_stem(stem: str) -> str:
     :data:`NAME_MAX` bytes: a 249-character output's ``.NAME.PID.RANDOM.partial.mp4``
     failed with "File name too long" once the work was done.
 
-    >>> len(short_stem("é" * 200).encode()), short_stem("take-1")
-    (206, 'take-1')
+    A byte that is not UTF-8 (a Latin-1 name off an old card: ``caf\\xe9``) is written
+    as U+FFFD: the name's surrogate escapes failed it ("surrogates not allowed").
+
+    >>> len(short_stem("é" * 200).encode()), short_stem("take-1"), short_stem("caf\\udce9")
+    (206, 'take-1', 'caf�')
     """
-    data = stem.encode()[: NAME_MAX - TEMP_NAME_BYTES]
-    return data.decode(errors="ignore")
+    clean = stem.encode(errors="surrogateescape").decode(errors="replace")
+    return clean.encode()[: NAME_MAX - TEMP_NAME_BYTES].decode(errors="ignore")
 
 
 _OWNER = re.compile(r"\.(\d+)\.[^.]+\.partial")  # the pid in .NAME.PID.RANDOM.partial.SUFFIX

@@ -18,6 +18,9 @@ from stabilize.video.i420 import pipe_layout
 from stabilize.video.probe import VideoError, VideoInfo, probe
 from stabilize.video.sequence import is_pattern
 
+# The input's name while ffmpeg-python composes the command, which hashes every argument
+# as UTF-8: a name that is not (a Latin-1 name off an old card, caf\xe9.mp4) failed it
+STAND_IN = "<the input>"
 # FFmpeg's filters that turn a frame counter-clockwise by a display rotation (degrees)
 TURN_FILTERS = {
     90: (("transpose", "cclock"),),
@@ -60,7 +63,7 @@ def read_frames(
         options["skip_loop_filter"] = "all"
     # the first video stream, as probe lists it: FFmpeg's own choice is the largest, and
     # a dashcam's front camera after its smaller rear one was read at the rear's size
-    stream = ffmpeg.input(local(path, "image2" in args), **options)["v:0"]
+    stream = ffmpeg.input(STAND_IN, **options)["v:0"]
     if exif_turn:
         mirror = (("hflip", None),) if info.mirror else ()
         for name, value in (*mirror, *TURN_FILTERS.get(info.rotation, ())):
@@ -80,11 +83,14 @@ def read_frames(
     if (h, w) != source:  # to the working size, or an anamorphic stream's pixels
         stream = stream.filter("scale", w, h, flags="area" if shrink else "bicubic")
         stream = stream.filter("setsar", "1")
-    process = (
+    cmd = (
         stream.output("pipe:", format="rawvideo", pix_fmt=pix_fmt, fps_mode="passthrough")
         .global_args("-hide_banner", "-loglevel", "error", "-nostdin")
-        .run_async(cmd=ffmpeg_exe(), pipe_stdout=True, pipe_stderr=True)
+        .compile(cmd=ffmpeg_exe())
     )
+    source = local(path, "image2" in args)
+    cmd = [source if arg == STAND_IN else arg for arg in cmd]
+    process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     widen_pipe(process.stdout)
     said = drain(process.stderr)
     shape, dtype = pipe_layout(pix_fmt, (h, w))

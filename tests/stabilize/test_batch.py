@@ -248,3 +248,17 @@ def test_a_worker_that_dies_costs_its_file_alone(folder, tmp_path):
     failed = [r for r in rows if r["status"] == "failed"]
     assert len(failed) == 1 and failed[0]["error"] == batch.WORKER_DIED
     assert all(Path(r["output"]).is_file() for r in rows if r["status"] == "done")
+
+
+def test_a_name_that_is_not_utf8_is_done_and_listed(tmp_path):
+    # caf\xe9.mp4 (Latin-1, off an old card): the manifest's CSV failed the whole batch,
+    # "internal error (UnicodeEncodeError: ... surrogates not allowed)"
+    src, out = tmp_path / "in", tmp_path / "out"
+    src.mkdir()
+    name = os.fsdecode(b"caf\xe9.mp4")
+    (src / name).write_bytes(SAMPLE.read_bytes())
+    result = CliRunner().invoke(app, ["batch", str(src), str(out), "-q"])
+    assert result.exit_code == 0, result.output
+    (row,) = json.loads((out / "manifest.json").read_text())
+    assert row["input"] == name and row["status"] == "done" and (out / name).is_file()
+    assert b"caf\xe9.mp4,done" in (out / "manifest.csv").read_bytes()  # its own bytes

@@ -3,6 +3,7 @@ zoom, rotation metadata, bit depth."""
 
 import json
 import math
+import os
 import subprocess
 from pathlib import Path
 
@@ -334,3 +335,15 @@ def test_a_damaged_clip_is_stabilised_from_the_frames_that_decode(shaky, tmp_pat
     assert summary["frames"] == len(decoded) and probe(out).has_audio
     np.testing.assert_allclose(frame_times(out), decoded, atol=1e-3)  # each at its own time
     assert any(line.startswith("damaged: ") for line in heard)
+
+
+def test_a_name_that_is_not_utf8_works(shaky, tmp_path):
+    # a Latin-1 name off an old camera's card or a zip archive: "'utf-8' codec can't encode
+    # character '\udce9': surrogates not allowed", the input's in the decoder's command,
+    # the output's in its temporary name
+    clip = tmp_path / os.fsdecode(b"caf\xe9.mp4")
+    clip.write_bytes(shaky.read_bytes())
+    out = tmp_path / os.fsdecode(b"d\xe9") / os.fsdecode(b"steady \xe9t\xe9.mp4")
+    summary, _ = stabilize_video(clip, out, Settings(fov=70.0))
+    assert summary["frames"] == 60 and probe(out).has_audio
+    assert os.listdir(os.fsencode(out.parent)) == [b"steady \xe9t\xe9.mp4"]
