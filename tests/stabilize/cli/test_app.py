@@ -3,6 +3,11 @@ traceback (unless asked for)."""
 
 from __future__ import annotations
 
+import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +15,8 @@ import pytest
 
 from stabilize.cli import main
 from stabilize.cli.app import LONGEST, one_line
+from stabilize.video import ffmpeg_exe
+from tests.stabilize.helpers import SAMPLE
 
 
 def test_a_message_is_one_line_however_it_came():
@@ -70,3 +77,46 @@ def test_ctrl_c_is_one_line_and_status_130(monkeypatch, tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error: interrupted"), err
     assert not Path(out).exists()
+
+
+def test_sigterm_is_one_line_and_status_143(monkeypatch, tmp_path, capsys):
+    def terminated(*args, **kwargs):  # `kill`, `timeout`, a job scheduler
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(5)  # (the handler interrupts this)
+
+    def unheard(*_):  # this test's own, so that a SIGTERM main() misses ends no run
+        raise RuntimeError("main() set no handler for SIGTERM")
+
+    monkeypatch.setattr("stabilize.pipeline.stabilize_video", terminated)
+    clip, out = tmp_path / "in.mp4", tmp_path / "out.mp4"
+    clip.write_bytes(b"")
+    monkeypatch.setattr("sys.argv", ["stabilize", str(clip), str(out), "-q"])
+    before = signal.signal(signal.SIGTERM, unheard)
+    try:
+        with pytest.raises(SystemExit) as done:
+            main()
+        assert signal.getsignal(signal.SIGTERM) is unheard  # put back as it was
+    finally:
+        signal.signal(signal.SIGTERM, before)
+    assert done.value.code == 143
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["error: terminated (SIGTERM); no output was left half-written under its name"]
+
+
+def test_sigterm_leaves_no_temporary_file(tmp_path):
+    # it ended the process where it stood: a hidden .out.PID.RANDOM.partial.mp4 was left
+    clip, out = tmp_path / "long.mp4", tmp_path / "out" / "steady.mp4"
+    loop = ["-stream_loop", "3", "-i", str(SAMPLE / "clip.mp4"), "-vf", "scale=320:180"]
+    subprocess.run([ffmpeg_exe(), "-v", "error", *loop, str(clip)], check=True)
+    job = subprocess.Popen(
+        [sys.executable, "-m", "stabilize.cli", str(clip), str(out), "-q"],
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.time() + 120
+    while time.time() < deadline and not list(out.parent.glob(".*.partial*")):
+        time.sleep(0.05)
+    job.send_signal(signal.SIGTERM)
+    _, err = job.communicate(timeout=60)
+    assert job.returncode == 143 and "error: terminated (SIGTERM)" in err
+    assert list(out.parent.iterdir()) == []
