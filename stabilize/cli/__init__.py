@@ -55,10 +55,13 @@ def main() -> None:
     with one line and 143; a fault of ours (an exception no command turned into an
     ``error:`` line) one line and status 1.
     """
-    terminated, previous = _stop_on_sigterm()
     args = sys.argv[1:]
     if args and args[0] not in COMMANDS and args[0] not in TOP_LEVEL:
         args = ["run", *args]
+    # (not a batch: its pool's exit would wait for every file still queued, workers that
+    # SIGTERM never reached going on; it ends where it stands, and the next run sweeps
+    # its temporary files)
+    terminated, previous = ([], None) if args[:1] == ["batch"] else _stop_on_sigterm()
     try:
         status = app(args=args, prog_name="stabilize", standalone_mode=False)
     except TyperException as err:  # click's usage errors, in typer's own copy of click
