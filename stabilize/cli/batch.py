@@ -145,7 +145,9 @@ def _jobs(params: dict, settings) -> list:
     fmt, pattern = params["output_format"], params["pattern"]
     suffix = (fmt if fmt.startswith(".") else f".{fmt}") if fmt else None
     if suffix:
-        run_or_fail(lambda: check_encoder(Path(f"check{suffix}"), settings.encoding, (64, 64)))
+        # named as the outputs are (OUT_DIR/*.mkv): its message named a file 'check.xyz'
+        every = Path(params["out_dir"]) / f"*{suffix}"
+        run_or_fail(lambda: check_encoder(every, settings.encoding, (64, 64)))
     gyro_auto = params["gyro"] == "auto"
     in_dir, out_dir = params["in_dir"], params["out_dir"]
     inside = Path(in_dir).resolve()

@@ -42,3 +42,13 @@ def test_batch_passes_the_options_on(tmp_path):
     result = CliRunner().invoke(app, args)
     assert result.exit_code == 0, result.output
     assert probe(out / "a.mp4").size == (180, 320)
+
+
+def test_a_format_with_no_container_names_the_outputs(tmp_path):
+    # it named the check's own file: "check.xyz: .xyz names no container"
+    src = tmp_path / "in"
+    src.mkdir()
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["batch", str(src), str(out), "--format", "xyz"])
+    assert result.exit_code == 2
+    assert f"error: {out / '*.xyz'}: .xyz names no container FFmpeg writes" in result.output
