@@ -53,7 +53,13 @@ from stabilize.video.encode import EncodeError, Encoding, Mux
 from stabilize.video.encoders import unused_quality
 from stabilize.video.fields import DEINTERLACE_MODES, field_times
 from stabilize.video.i420 import chroma, pipe_format
-from stabilize.video.preflight import check_encoder, check_streams, check_writable, describe
+from stabilize.video.preflight import (
+    check_encoder,
+    check_streams,
+    check_times,
+    check_writable,
+    describe,
+)
 from stabilize.video.sequence import (
     first_image,
     is_pattern,
@@ -192,7 +198,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     check_writable(dst)
     container = container_for(dst)
     encoding = output_encoding(info, settings, container)
-    check_encoder(dst, encoding, encoded_size(info, settings))
+    check_encoder(dst, encoding, encoded_size(info, settings), info.fps or 30.0)
     lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
     times = frame_times(src, info.input_args)  # read once: the packets, not the pixels
     stamps = None
@@ -204,12 +210,13 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     if info.fields:  # a frame for each field, each at its own time
         times = field_times(times)
         stamps = None if stamps is None else field_times(stamps)
+    check_times(dst, times)
     # Last, once every check has passed (it decodes frames): the picture inside black
     # bars baked into the frame. A lens's frame is the sensor's, bars or not.
     if settings.bars == "auto" and not settings.lens:
         info = info.within_bars(detect_bars(info))
     mux = keep_streams(info, container, info.video_delay)
-    check_streams(dst, encoding, encoded_size(info, settings), mux)
+    check_streams(dst, encoding, encoded_size(info, settings), mux, info.fps or 30.0)
     notices = mux.notices + fields_notice(info) + pixels_notice(info) + bars_notice(info)
     if not container.timed:  # an image sequence: numbered as the input's, else from 1
         first = first_image(info.input_args)

@@ -42,7 +42,8 @@ class Container:
     deep_encoder: str | None = None
     data: frozenset[str] = frozenset()  # data tracks held as they are, by codec tag
     # Where a start timecode goes: "track" (written again from the video's timecode tag
-    # as a tmcd track, as QuickTime does), "tag" (kept as the video's tag), "" (nowhere)
+    # as a timecode track: QuickTime's tmcd, MXF's own), "tag" (kept as the video's
+    # tag), "" (nowhere)
     timecode: str = ""
     # An image sequence's pictures (OUT a pattern, frames/%05d.png): their pixel formats
     # for an 8-bit source and for a deeper one (None: the pipe's 4:2:0 at its depth)
@@ -57,6 +58,9 @@ class Container:
     fine_clock: bool = True
     # Attached files (the fonts an ASS subtitle track is drawn with), Matroska's alone
     attachments: bool = False
+    # Whether it keeps each frame's own time (a variable rate): MXF holds one edit rate
+    variable_rate: bool = True
+    audio_rate: int | None = None  # the one sample rate its audio takes (Hz; None: any)
 
     @property
     def timed(self) -> bool:
@@ -147,6 +151,23 @@ MPEG_PS = Container(
     name="MPEG-PS",
 )
 
+# Broadcast and editing (an OP1a file, as cameras and editors write): H.264 video, 48 kHz
+# PCM audio alone (FFmpeg's muxer: "only 48khz is implemented"), no subtitles or chapters.
+# Its index holds each frame's distance from its keyframe in a byte: FFmpeg's default GOP
+# (250) failed a clip longer than 129 frames once the work was done ("frame offset (-129)")
+MXF = Container(
+    "mxf",
+    audio=frozenset(),
+    audio_encoder="pcm_s24le",
+    audio_rate=48_000,
+    subtitles=frozenset(),
+    chapters=False,
+    options=("-g", "120"),
+    timecode="track",  # its own timecode track
+    variable_rate=False,
+    name="MXF",
+)
+
 JPEG = image_sequence("mjpeg", ("yuvj420p", "yuvj420p"))  # full range, as JPEG files are
 TIFF = image_sequence("tiff", ("rgb24", "rgb48le"))
 
@@ -200,6 +221,7 @@ CONTAINERS: dict[str, Container] = {
     ".mpg": MPEG_PS,
     ".mpeg": MPEG_PS,
     ".vob": MPEG_PS,
+    ".mxf": MXF,
     ".gif": animation("gif", "gif", pix_fmt="pal8", video_filter=GIF_PALETTE, name="GIF"),
 }
 

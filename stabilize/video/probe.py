@@ -195,6 +195,23 @@ _SAR = re.compile(r"\[SAR (\d+):(\d+) DAR")
 _ROTATION = re.compile(r"rotation of (-?\d+(?:\.\d+)?) degrees|rotate\s*:\s*(-?\d+)")
 
 
+def exact_rate(listed: float) -> float:
+    """The frame rate FFmpeg lists to two decimals, NTSC's N·1000/1001 made whole.
+
+    A clip at 24000/1001 fps is listed as "23.98": written at 23.98 fps, its video ran
+    ahead of its audio by 0.1 s every 10 minutes, and MXF refused the rate. A listed rate
+    that N·1000/1001 rounds to, and no whole N, is taken to be that rate.
+
+    >>> exact_rate(23.98) == 24000 / 1001, exact_rate(29.97) == 30000 / 1001
+    (True, True)
+    >>> exact_rate(25.0), exact_rate(29.74)
+    (25.0, 29.74)
+    """
+    whole = round(listed * 1.001)
+    ntsc = whole * 1000 / 1001
+    return ntsc if whole and listed != whole and round(ntsc, 2) == listed else listed
+
+
 def _listing(text: str, start: int) -> str:
     """What FFmpeg lists of the stream whose line starts at ``start``: its line, its
     Metadata and Side data lines, up to the next stream (indented deeper within a stream
@@ -273,7 +290,7 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     codec, pix_fmt, w, h = video.group(1), video.group(2), int(video.group(4)), int(video.group(5))
     stream_line = text[video.start() : text.find("\n", video.start())]
     fps_match = _FPS.search(stream_line)
-    fps = float(fps_match.group(1)) if fps_match else 0.0
+    fps = exact_rate(float(fps_match.group(1))) if fps_match else 0.0
     dur = _DURATION.search(text)
     duration = (
         int(dur.group(1)) * 3600 + int(dur.group(2)) * 60 + float(dur.group(3)) if dur else None

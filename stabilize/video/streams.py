@@ -53,6 +53,8 @@ def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0
         if codec != "copy":
             notices.append(f"{stream.kind} #{stream.index}: {stream.codec} → {codec} for {where}")
         args += ["-map", f"1:{stream.index}", f"-c:{flag}:{count[flag]}", codec]
+        if flag == "a" and codec != "copy" and container.audio_rate:
+            args += [f"-ar:a:{count[flag]}", str(container.audio_rate)]
         count[flag] += 1
         kept.append(stream.index)
     # One mapping per stream: any explicit one turns FFmpeg's per-stream default off.

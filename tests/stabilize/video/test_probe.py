@@ -14,3 +14,13 @@ def test_an_audio_file_is_said_to_be_one(tmp_path):
     subprocess.run([ffmpeg_exe(), "-v", "error", *tone, str(audio)], check=True)
     with pytest.raises(VideoError, match=r"voice\.m4a: has no video stream, only audio"):
         probe(audio)
+
+
+@pytest.mark.parametrize(("rate", "fps"), [("24000/1001", 24000 / 1001), ("25", 25.0)])
+def test_an_ntsc_frame_rate_is_read_whole(tmp_path, rate, fps):
+    # FFmpeg lists 24000/1001 as "23.98": written at 23.98, the video ran ahead of the
+    # audio by 0.1 s every 10 minutes
+    clip = tmp_path / "ntsc.mp4"
+    frames = ["-f", "lavfi", "-i", f"color=black:s=64x64:r={rate}", "-frames:v", "3"]
+    subprocess.run([ffmpeg_exe(), "-v", "error", *frames, str(clip)], check=True)
+    assert probe(clip).fps == fps

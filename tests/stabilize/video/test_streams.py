@@ -4,6 +4,7 @@ count and by content, into MKV and MP4 outputs; and the container the suffix nam
 from __future__ import annotations
 
 import subprocess
+from fractions import Fraction
 from pathlib import Path
 
 import av
@@ -167,6 +168,7 @@ def test_hevc_in_mp4_is_tagged_hvc1(tmp_path):
 
 MUXERS = {".mp4": "mp4", ".m4v": "mp4", ".mov": "mov", ".mkv": "matroska", ".webm": "webm"}
 MUXERS |= {".avi": "avi", ".ts": "mpegts", ".gif": "gif", ".mpg": "vob", ".vob": "vob"}
+MUXERS |= {".mxf": "mxf"}
 MUXERS |= {".unknown": ""}
 
 
@@ -355,3 +357,34 @@ def test_avchd_and_blu_ray_suffixes_write_m2ts(rich, tmp_path, suffix):
             writer.write(np.zeros(writer.shape, writer.dtype))
     data = out.read_bytes()
     assert len(data) % 192 == 0 and data[4::192][:100] == b"\x47" * 100  # 192-byte packets
+
+
+def test_mxf_takes_a_long_clip_and_its_audio_as_48_khz_pcm(rich, tmp_path):
+    # AAC audio was refused ("only 48khz is implemented"), and a clip of more than 129
+    # frames failed once the work was done ("frame offset (-129) ... reduce encoder GOP")
+    info, out, long = probe(rich["mp4"]), tmp_path / "out.mxf", tmp_path / "long.mxf"
+    mux = keep_streams(info, container_for(out))
+    assert "audio #1: aac → pcm_s24le for MXF" in mux.notices
+    assert "left out subtitle #3 (mov_text): MXF cannot hold it" in mux.notices
+    fast = Encoding(preset="ultrafast")
+    for path, frames, with_tracks in ((out, 60, mux), (long, 140, None)):
+        with FrameWriter(path, (64, 64), 30000 / 1001, fast, with_tracks) as writer:
+            for _ in range(frames):
+                writer.write(np.zeros(writer.shape, writer.dtype))
+    with av.open(str(out)) as c:
+        video, audio = c.streams.video[0], c.streams.audio
+        assert (video.codec_context.name, video.average_rate) == ("h264", Fraction(30000, 1001))
+        assert [(a.codec_context.name, a.sample_rate) for a in audio] == [("pcm_s24le", 48000)] * 2
+    with av.open(str(long)) as c:
+        assert sum(1 for packet in c.demux(c.streams.video[0]) if packet.size) == 140
+
+
+def test_mxf_writes_the_timecode_in_its_own_track(timecoded, tmp_path):
+    out = tmp_path / "out.mxf"
+    mux = keep_streams(probe(timecoded), container_for(out))
+    assert not mux.notices  # not "left out data #1 (tmcd)": MXF writes its own
+    with FrameWriter(out, (64, 64), 30.0, Encoding(preset="ultrafast"), mux) as writer:
+        for _ in range(3):
+            writer.write(np.zeros(writer.shape, writer.dtype))
+    with av.open(str(out)) as c:
+        assert c.metadata["timecode"] == TIMECODE  # the material package's timecode
