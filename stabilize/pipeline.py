@@ -126,8 +126,13 @@ def stabilize_video(
     except Damaged as damage:  # refused before, however few frames were lost
         if job.stamps is not None:  # a sensor log's frame times count every frame
             raise
-        job = replace(job, times=damage.frames_that_decode(job.info))
+        times = damage.frames_that_decode(job.info)  # from the first listed frame's
+        lead = float(times[0])  # the frames lost at the start: the video starts late
+        mux = replace(job.mux, video_delay=job.mux.video_delay + lead)
+        job = replace(job, times=times - lead, mux=mux)
         tell(damage.notice)
+        if lead > 0:
+            tell(f"damaged: the first {lead:.2f} s of video do not decode: it starts there")
         track, focal, rotations = _motion(src, job, settings, bar, tell)
     R, rolling, residual, repaired, gyro_summary, shutter, eased = rotations
     t_estimate = time.perf_counter() - start

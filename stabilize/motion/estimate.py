@@ -136,8 +136,9 @@ class Damaged(VideoError):
 
     def frames_that_decode(self, info: VideoInfo) -> NDArray:
         """The times of the frames that do decode (each field's, where each is a
-        frame), to run pass 1 again with; this error again where they are not the
-        frames pass 1 read."""
+        frame), to run pass 1 again with, from the first frame the container lists
+        (frames lost at the start leave the first at its own time); this error again
+        where they are not the frames pass 1 read."""
         times = frame_times(self.path, info.input_args, decoded=True)
         times = field_times(times) if info.fields else times
         if abs(len(times) - self.decoded) > 1:  # (a container may list one extra)

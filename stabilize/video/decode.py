@@ -132,14 +132,17 @@ def frame_times(path: str | Path, input_args: tuple = (), *, decoded: bool = Fal
     Where the packets carry no timestamps (AVI's MPEG-4 ASP, whose packets have only a
     decoding order), or with ``decoded`` (a damaged clip: the times of the frames that
     do decode, :func:`read_frames`' frames), the frames are decoded, cheaply (no pixels
-    leave FFmpeg), and their own times are taken instead.
+    leave FFmpeg), and their own times are taken instead. Those count from the first
+    frame the packets list, where they list times: frames lost at the start leave the
+    first that decodes at its own time, not at 0 (its video was written 2.7 s early,
+    ahead of its audio, on a clip whose first 80 frames did not decode).
     """
-    times = None if decoded else _framecrc_times(path, input_args, decode=False)
-    if times is None:
-        times = _framecrc_times(path, input_args, decode=True)
+    listed = _framecrc_times(path, input_args, decode=False)
+    times = _framecrc_times(path, input_args, decode=True) if decoded or listed is None else listed
     if times is None:
         raise VideoError(f"{path}: its frames carry no timestamps FFmpeg can read")
-    return times - times[0]
+    first = listed[0] if listed is not None and listed[0] <= times[0] else times[0]
+    return times - first
 
 
 def frame_interval(times: np.ndarray) -> float:
@@ -150,7 +153,9 @@ def frame_interval(times: np.ndarray) -> float:
 def _framecrc_times(path: str | Path, input_args: tuple, *, decode: bool) -> np.ndarray | None:
     """Sorted frame times from FFmpeg's framecrc of the first video stream: its packets
     (``decode`` False) or its decoded frames; None where some carry no timestamp."""
-    codec = ["-c:v", "wrapped_avframe"] if decode else ["-c", "copy"]
+    # decoded frames on the container's own clock: on the encoder's (1/frame rate) a
+    # variable rate's times were rounded to whole frames of its mean rate
+    codec = ["-c:v", "wrapped_avframe", "-enc_time_base:v", "demux"] if decode else ["-c", "copy"]
     cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i"]
     cmd += [local(path, "image2" in input_args), "-map", "0:v:0", *codec, "-f", "framecrc", "-"]
     result = subprocess.run(cmd, capture_output=True, text=True, errors="replace")

@@ -50,15 +50,16 @@ def squeezed(folder: Path) -> Path:
     return out
 
 
-def damaged(clip: Path, folder: Path) -> Path:
-    """``clip`` as MPEG-TS with a stretch of its video packets damaged (from 30% to 60%
-    of the file, a byte in seven flipped), as a failing card or a broken stream leaves
-    one: a fifth of the frames its packets list do not decode."""
+def damaged(clip: Path, folder: Path, within: tuple[float, float] = (0.3, 0.6)) -> Path:
+    """``clip`` as MPEG-TS with a stretch of its video packets damaged (by default from
+    30% to 60% of the file, a byte in seven flipped), as a failing card or a broken
+    stream leaves one: a fifth of the frames its packets list do not decode."""
     out = folder / "damaged.ts"
     encode = ["-c:v", "libx264", "-g", "10", "-c:a", "aac"]
     subprocess.run([ffmpeg_exe(), "-v", "error", "-i", str(clip), *encode, str(out)], check=True)
     data = bytearray(out.read_bytes())
-    for k in range(len(data) // 188 * 3 // 10, len(data) // 188 * 6 // 10):
+    packets = len(data) // 188
+    for k in range(max(int(packets * within[0]), 2), int(packets * within[1])):  # PAT, PMT
         p = 188 * k
         if data[p + 1] & 0x1F == 0x01 and data[p + 2] == 0x00:  # the video's PID, 0x100
             data[p + 30 : p + 188 : 7] = bytes(b ^ 0xFF for b in data[p + 30 : p + 188 : 7])

@@ -7,6 +7,7 @@ import os
 import subprocess
 from pathlib import Path
 
+import av
 import numpy as np
 import pytest
 
@@ -55,6 +56,8 @@ def test_variable_frame_rate_timestamps_are_kept(shaky, tmp_path):
     )
     times = frame_times(vfr)
     assert len(times) == 60 and np.ptp(np.diff(times)) > 0.01  # really variable
+    # a damaged clip's times, decoded: they were rounded to its mean rate's frames
+    np.testing.assert_allclose(frame_times(vfr, decoded=True), times, atol=1e-4)
     out = tmp_path / "out.mp4"
     summary, _ = stabilize_video(vfr, out, Settings(fov=70.0))
     np.testing.assert_allclose(frame_times(out), times, atol=1e-3)
@@ -335,6 +338,22 @@ def test_a_damaged_clip_is_stabilised_from_the_frames_that_decode(shaky, tmp_pat
     assert summary["frames"] == len(decoded) and probe(out).has_audio
     np.testing.assert_allclose(frame_times(out), decoded, atol=1e-3)  # each at its own time
     assert any(line.startswith("damaged: ") for line in heard)
+
+
+def test_a_clip_damaged_at_its_start_keeps_its_video_in_sync(shaky, tmp_path):
+    # the first frame that decoded was written at the start, ahead of its audio (by
+    # 0.17 s here, 2.7 s on a 12 s clip)
+    ts, out = damaged(shaky, tmp_path, within=(0.0, 0.3)), tmp_path / "out.mkv"
+    lead = frame_times(ts, decoded=True)[0]
+    assert lead > 0.1  # five frames lost
+    stabilize_video(ts, out, Settings(fov=70.0))
+
+    def starts(path: Path) -> list[float]:
+        with av.open(str(path)) as c:
+            return [float(s.start_time * s.time_base) for s in c.streams]
+
+    (video, audio), (source_video, source_audio) = starts(out), starts(ts)
+    assert video - audio == pytest.approx(source_video - source_audio + lead, abs=0.002)
 
 
 def test_a_name_that_is_not_utf8_works(shaky, tmp_path):
