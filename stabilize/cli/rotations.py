@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import typer
@@ -21,12 +22,15 @@ from stabilize.cli.options import (
 )
 from stabilize.settings import DEFAULTS
 
+STDOUT = Path("-")  # the Unix name of standard output, where a file is asked for
+
 
 @app.command(
     epilog=(
         "Examples:\n\n"
         "  stabilize rotations clip.mp4 -o rotations.csv\n\n"
         "  stabilize rotations clip.mp4 --gcsv clip.gcsv     # for Gyroflow\n\n"
+        "  stabilize rotations clip.mp4 -o - | head\n\n"
         "  stabilize rotations clip.mp4 -o rot.csv --flow raft --raft-weights raft-small.pth"
     )
 )
@@ -35,10 +39,12 @@ def rotations(
         ..., metavar="IN", help="A video, or an image sequence (frames/img-%d.jpg)."
     ),
     output: Path | None = typer.Option(
-        None, "-o", "--output", help="CSV: frame,t,rx,ry,rz,support."
+        None, "-o", "--output", help="CSV: frame,t,rx,ry,rz,support ('-': standard output)."
     ),
     gcsv: Path | None = typer.Option(
-        None, help="Also (or only) write the rates as a Gyroflow .gcsv, for clips with no gyro."
+        None,
+        help="Also (or only) write the rates as a Gyroflow .gcsv, for clips with no gyro "
+        "('-': standard output).",
     ),
     flow_name: FlowOption = DEFAULTS.flow,
     raft_weights: RaftWeightsOption = None,
@@ -67,6 +73,8 @@ def rotations(
     if len(targets) == 2 and output.resolve() == gcsv.resolve():
         fail(f"-o and --gcsv both name {output}: give each its own file")
     for target in targets:  # before any work, not after it
+        if target == STDOUT:
+            continue
         run_or_fail(lambda target=target: check_not_input(target, input_path))
         run_or_fail(lambda target=target: check_absent(target, overwrite))
         run_or_fail(lambda target=target: check_writable(target))
@@ -87,10 +95,17 @@ def rotations(
     across = f"{focal.fov_deg:.1f}° across the long side"
     notice(f"focal length {focal.px:.1f} px ({across}, {focal.source})")
     if output is not None:
-        with atomic_output(output, overwrite=overwrite) as tmp:
-            write_rotations(tmp, track.times[:-1], so3.log_so3(track.rotations), track.support)
+        rows = (track.times[:-1], so3.log_so3(track.rotations), track.support)
+        if output == STDOUT:
+            write_rotations(sys.stdout, *rows)
+        else:
+            with atomic_output(output, overwrite=overwrite) as tmp:
+                write_rotations(tmp, *rows)
     if gcsv is not None:
         from stabilize.gyro.export import write_gcsv
 
-        with atomic_output(gcsv, overwrite=overwrite) as tmp:
-            write_gcsv(tmp, track.times, track.rotations)
+        if gcsv == STDOUT:
+            write_gcsv(sys.stdout, track.times, track.rotations)
+        else:
+            with atomic_output(gcsv, overwrite=overwrite) as tmp:
+                write_gcsv(tmp, track.times, track.rotations)

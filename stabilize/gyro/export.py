@@ -9,13 +9,15 @@ can remap it if its convention for a clip differs.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TextIO
 
 from numpy.typing import NDArray
 
 from stabilize.gyro.sync import visual_rates
 
 
-def write_gcsv(path: str | Path, times: NDArray, R: NDArray) -> None:
+def write_gcsv(path: str | Path | TextIO, times: NDArray, R: NDArray) -> None:
+    """The visual rates as a Gyroflow .gcsv log, into a file or an open text stream."""
     rates = visual_rates(times, R)
     mid_ms = 1000.0 * 0.5 * (times[1:] + times[:-1])
     lines = [
@@ -31,7 +33,11 @@ def write_gcsv(path: str | Path, times: NDArray, R: NDArray) -> None:
     lines += [
         f"{t:.3f},{x:.9f},{y:.9f},{z:.9f}" for t, (x, y, z) in zip(mid_ms, rates, strict=True)
     ]
-    Path(path).write_text("\n".join(lines) + "\n")
+    text = "\n".join(lines) + "\n"
+    if isinstance(path, str | Path):
+        Path(path).write_text(text)
+    else:
+        path.write(text)
 
 
 __all__ = ["write_gcsv"]

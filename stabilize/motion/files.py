@@ -5,7 +5,9 @@ vector in radians, CONVENTIONS.md). ``stabilize rotations`` writes them, with a
 from __future__ import annotations
 
 import csv
+from contextlib import nullcontext
 from pathlib import Path
+from typing import TextIO
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,9 +38,11 @@ def read_rotations(path: str | Path) -> dict[int, NDArray[np.float64]]:
     return out
 
 
-def write_rotations(path: str | Path, times, rotvecs, support) -> None:
-    """``frame,t,rx,ry,rz,support`` for each pair (frame k → k+1)."""
-    with open(path, "w", newline="") as f:
+def write_rotations(path: str | Path | TextIO, times, rotvecs, support) -> None:
+    """``frame,t,rx,ry,rz,support`` for each pair (frame k → k+1), into a file or an open
+    text stream (standard output)."""
+    opened = open(path, "w", newline="") if isinstance(path, str | Path) else nullcontext(path)
+    with opened as f:
         writer = csv.writer(f)
         writer.writerow([*COLUMNS, "support"])
         for k, (t, rv, s) in enumerate(zip(times, rotvecs, support, strict=True)):

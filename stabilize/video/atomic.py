@@ -18,13 +18,17 @@ from stabilize.video.sequence import is_pattern, sequence_files
 def check_absent(path: str | os.PathLike, overwrite: bool) -> None:
     """FileExistsError where ``path`` exists (an image sequence: any of its pictures)
     and may not be replaced; ValueError where it is a folder, which no output replaces
-    (``out.mp4/`` made by mistake: the run failed once its work was done)."""
+    (``out.mp4/`` made by mistake: the run failed once its work was done), or a pipe or
+    a device, which the final rename would replace with a file."""
     final = Path(path)
     if final.is_dir():
         raise ValueError(
             f"{final} is a folder: name the output file, e.g. {final / 'out'}"
             f"{final.suffix or '.mp4'}"
         )
+    if final.exists() and not final.is_file():
+        # renamed over, even with --overwrite: a FIFO or a device node became a plain file
+        raise ValueError(f"{final} is a pipe or a device, not a file: name a file")
     if overwrite:
         return
     if is_sequence(final) and (found := sequence_files(final)):

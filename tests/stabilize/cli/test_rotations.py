@@ -1,9 +1,11 @@
 """``stabilize rotations``: the rotations file."""
 
+import subprocess
+
 from typer.testing import CliRunner
 
 from stabilize.cli import app
-from stabilize.video import frame_times
+from stabilize.video import ffmpeg_exe, frame_times
 from tests.stabilize.helpers import damaged, held_upright
 
 
@@ -13,6 +15,18 @@ def test_rotations_command(shaky, tmp_path):
     assert result.exit_code == 0, result.output
     lines = out.read_text().splitlines()
     assert lines[0] == "frame,t,rx,ry,rz,support" and len(lines) == 60
+
+
+def test_standard_output_takes_the_rotations_and_the_gcsv(shaky, tmp_path):
+    # '-' was a file named '-'
+    clip = tmp_path / "three.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-frames:v", "3", str(clip)]
+    subprocess.run(cmd, check=True)
+    for option, first in (("-o", "frame,t,rx,ry,rz,support"), ("--gcsv", "GYROFLOW IMU LOG")):
+        result = CliRunner().invoke(app, ["rotations", str(clip), option, "-", "--fov", "70"])
+        assert result.exit_code == 0, result.output
+        assert result.stdout.splitlines()[0] == first and len(result.stdout.splitlines()) > 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["three.mp4"]
 
 
 def test_a_damaged_clip_gives_the_rotations_of_the_frames_that_decode(shaky, tmp_path):

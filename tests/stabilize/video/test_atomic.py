@@ -95,3 +95,14 @@ def test_a_name_near_the_longest_a_folder_holds_gets_a_temporary_name_beside_it(
         assert len(tmp.name.encode()) <= 255
         tmp.write_bytes(b"video")
     assert final.read_bytes() == b"video"
+
+
+@pytest.mark.parametrize("overwrite", [False, True])
+def test_a_pipe_at_the_outputs_name_is_never_replaced(tmp_path, overwrite):
+    # the final rename made a FIFO (or a device node, /dev/null's twin) a plain file
+    fifo = tmp_path / "out.mp4"
+    os.mkfifo(fifo)
+    with pytest.raises(ValueError, match=r"out\.mp4 is a pipe or a device, not a file"):
+        with atomic_output(fifo, overwrite=overwrite) as tmp:
+            tmp.write_bytes(b"video")
+    assert fifo.is_fifo() and os.listdir(tmp_path) == ["out.mp4"]
