@@ -291,6 +291,8 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     stream_line = text[video.start() : text.find("\n", video.start())]
     fps_match = _FPS.search(stream_line)
     fps = exact_rate(float(fps_match.group(1))) if fps_match else 0.0
+    given = dict(zip(input_args[::2], input_args[1::2], strict=False)).get("-framerate")
+    fps = float(given) if given else fps  # an image sequence's --fps, as the user gave it
     dur = _DURATION.search(text)
     duration = (
         int(dur.group(1)) * 3600 + int(dur.group(2)) * 60 + float(dur.group(3)) if dur else None

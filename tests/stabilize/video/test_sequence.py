@@ -67,6 +67,8 @@ def test_a_gap_in_a_sequence_is_refused_where_ffmpeg_would_stop_at_it(shaky, tmp
     cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-frames:v", "12", str(pattern)]
     subprocess.run(cmd, check=True)
     assert probe(pattern).width > 0  # 1–12, no gap
+    # its rate as given: FFmpeg lists 23.98 for --fps 23.98, which read 24000/1001
+    assert probe(pattern, sequence_args(pattern, fps=23.98)).fps == 23.98
     (tmp_path / "f005.png").unlink()
     with pytest.raises(VideoError, match=r"image 5 is missing \(1–4 exist, then 6 on\).* 7 images"):
         probe(pattern)
