@@ -58,10 +58,7 @@ def main() -> None:
     args = sys.argv[1:]
     if args and args[0] not in COMMANDS and args[0] not in TOP_LEVEL:
         args = ["run", *args]
-    # (not a batch: its pool's exit would wait for every file still queued, workers that
-    # SIGTERM never reached going on; it ends where it stands, and the next run sweeps
-    # its temporary files)
-    terminated, previous = ([], None) if args[:1] == ["batch"] else _stop_on_sigterm()
+    terminated, previous = _stop_on_sigterm()  # a batch's workers too (batch._stop)
     try:
         status = app(args=args, prog_name="stabilize", standalone_mode=False)
     except TyperException as err:  # click's usage errors, in typer's own copy of click

@@ -14,6 +14,7 @@ from typer.testing import CliRunner
 
 from stabilize.batch import find_jobs
 from stabilize.cli import app
+from stabilize.video import ffmpeg_exe
 from tests.stabilize.helpers import SAMPLE as SAMPLE_DIR
 
 SAMPLE = SAMPLE_DIR / "clip.mp4"
@@ -220,6 +221,38 @@ def test_an_output_a_killed_run_wrote_is_still_its_own(folder, tmp_path, monkeyp
     monkeypatch.undo()
     (row,) = batch.run_batch(jobs, out, Settings())
     assert "not from a batch" not in row["error"]  # done again, not taken for a stranger's
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGINT])
+def test_a_stopped_batch_stops_its_workers_and_starts_no_queued_file(tmp_path, signum):
+    # SIGTERM ended the batch where it stood, its workers going on with their files, and
+    # Ctrl-C waited for every queued file (31 s for 2 of 4 one-minute clips)
+    src, out = tmp_path / "in", tmp_path / "out"
+    src.mkdir()
+    loop = ["-stream_loop", "1", "-i", str(SAMPLE), "-vf", "scale=320:180"]
+    subprocess.run([ffmpeg_exe(), "-v", "error", *loop, str(src / "a.mp4")], check=True)
+    for name in ("b.mp4", "c.mp4", "d.mp4"):
+        (src / name).write_bytes((src / "a.mp4").read_bytes())
+    job = subprocess.Popen(
+        [sys.executable, "-m", "stabilize.cli", "batch", str(src), str(out), "--workers", "2"],
+        start_new_session=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.time() + 120
+    while time.time() < deadline and not list(out.glob(".*.partial*")):
+        time.sleep(0.05)
+    if signum == signal.SIGINT:  # Ctrl-C: the terminal signals the whole group
+        os.killpg(job.pid, signum)
+    else:  # kill, timeout, a job scheduler: the batch's own process alone
+        job.send_signal(signum)
+    _, err = job.communicate(timeout=60)
+    assert job.returncode == 128 + signum and err.splitlines()[-1].startswith("error: ")
+    time.sleep(3)  # what a worker left going would write meanwhile
+    assert sorted(p.name for p in out.iterdir()) == ["manifest.csv", "manifest.json"]
+    rows = json.loads((out / "manifest.json").read_text())
+    assert {r["status"] for r in rows} == {"started"}  # all done again by the next run
 
 
 def test_a_worker_that_dies_costs_its_file_alone(folder, tmp_path):
