@@ -153,9 +153,10 @@ def frame_interval(times: np.ndarray) -> float:
 def _framecrc_times(path: str | Path, input_args: tuple, *, decode: bool) -> np.ndarray | None:
     """Sorted frame times from FFmpeg's framecrc of the first video stream: its packets
     (``decode`` False) or its decoded frames; None where some carry no timestamp."""
-    # decoded frames on the container's own clock: on the encoder's (1/frame rate) a
-    # variable rate's times were rounded to whole frames of its mean rate
-    codec = ["-c:v", "wrapped_avframe", "-enc_time_base:v", "demux"] if decode else ["-c", "copy"]
+    # (decoded frames on the encoder's clock, 1/frame rate, whose slots keep their times
+    # rising: on the container's own, a stream whose packets repeat a time, as FFmpeg
+    # writes a variable rate with B-frames into Matroska, gave two frames one time)
+    codec = ["-c:v", "wrapped_avframe"] if decode else ["-c", "copy"]
     cmd = [ffmpeg_exe(), "-hide_banner", "-nostdin", *input_args, "-i"]
     cmd += [local(path, "image2" in input_args), "-map", "0:v:0", *codec, "-f", "framecrc", "-"]
     result = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
