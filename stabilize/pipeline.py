@@ -76,6 +76,7 @@ from stabilize.warp.render import (
     output_encoding,
     piped_format,
     render,
+    shown_notice,
 )
 from stabilize.warp.rolling import RAMP_S, within_stretch
 
@@ -230,6 +231,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
             notices += ("an image sequence keeps no frame times (--report's path.csv has them)",)
     notices += encoder_notice(encoding, settings.encoding.codec_for(container))
     notices += unused_quality(encoding.codec, encoding.crf)
+    notices += shown_notice(times, container)
     notices += pipe_notices(info, piped_format(info, settings), encoding)
     if not settings.size and frame_size(info, settings) != info.shown_framed_size:
         (h, w), (sh, sw) = frame_size(info, settings), info.shown_framed_size

@@ -61,6 +61,9 @@ class Container:
     # Whether it keeps each frame's own time (a variable rate): MXF holds one edit rate
     variable_rate: bool = True
     audio_rate: int | None = None  # the one sample rate its audio takes (Hz; None: any)
+    # The least time between frames as its players show them (s; 0: none): browsers show
+    # a GIF frame of 0 or 10 ms for 100 ms, so a 60 fps clip played at a third its speed
+    min_interval: float = 0.0
 
     @property
     def timed(self) -> bool:
@@ -222,7 +225,9 @@ CONTAINERS: dict[str, Container] = {
     ".mpeg": MPEG_PS,
     ".vob": MPEG_PS,
     ".mxf": MXF,
-    ".gif": animation("gif", "gif", pix_fmt="pal8", video_filter=GIF_PALETTE, name="GIF"),
+    ".gif": animation(
+        "gif", "gif", pix_fmt="pal8", video_filter=GIF_PALETTE, min_interval=0.02, name="GIF"
+    ),
 }
 
 

@@ -29,6 +29,23 @@ def is_variable_rate(times: NDArray, tolerance: float = 0.01) -> bool:
     return bool(np.max(np.abs(times - line)) > max(tolerance * step, CLOCK_SLACK))
 
 
+def thinned(times: NDArray, interval: float) -> NDArray[np.intp]:
+    """The frames kept where none may follow the last kept sooner than ``interval`` s:
+    each the first that comes late enough (every other frame of a 60 fps clip, at 20 ms).
+
+    >>> thinned(np.arange(7) / 60, 0.02).tolist()
+    [0, 2, 4, 6]
+    >>> thinned(np.array([0.0, 0.0467, 0.0933, 0.1, 0.1467]), 0.02).tolist()
+    [0, 1, 2, 4]
+    """
+    times = np.asarray(times, dtype=np.float64)
+    kept = [0] if len(times) else []
+    for k in range(1, len(times)):
+        if times[k] - times[kept[-1]] >= interval - 1e-6:  # (a clock's rounding)
+            kept.append(k)
+    return np.array(kept, dtype=np.intp)
+
+
 def retime(
     src: str | Path,
     dst: str | Path,

@@ -22,7 +22,7 @@ from stabilize.video import FrameWriter, VideoError, VideoInfo, i420, read_frame
 from stabilize.video.bars import put_back
 from stabilize.video.containers import Container, container_for
 from stabilize.video.encode import Encoding, Mux
-from stabilize.video.retime import is_variable_rate, retime
+from stabilize.video.retime import is_variable_rate, retime, thinned
 from stabilize.video.turn import turn
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.frames import resize_image
@@ -50,11 +50,15 @@ def render(
     """
     mux = mux or Mux()
     container = container_for(out)
-    written = 0
+    written, decoded_count = 0, 0
     fps = info.fps or 30.0
     h, w = frame_size(info, settings)
     size = encoded_size(info, settings)
-    variable = container.timed and is_variable_rate(planned.times)
+    shown = shown_frames(planned.times, container)
+    times = planned.times[shown]
+    if len(times) < len(planned.times) and not is_variable_rate(times):  # every k-th frame
+        fps = (len(times) - 1) / (times[-1] - times[0])
+    variable = container.timed and is_variable_rate(times)
     pix_fmt = piped_format(info, settings)
     planar = pix_fmt != "rgb24"
     encoding = replace(encoding, b_frames=False) if variable else encoding
@@ -62,7 +66,7 @@ def render(
     side_by_side = i420.hstack if planar else lambda a, b: np.hstack([a, b])
     resize = resize_planes if planar else resize_image
 
-    def shown(frame: NDArray) -> NDArray:
+    def as_written(frame: NDArray) -> NDArray:
         """A decoded or warped frame as it is written: framed by its black bars again,
         turned to be shown, then at the output's size."""
         if info.bars:
@@ -86,24 +90,37 @@ def render(
             colour=info.colour,
         ) as writer:
             decoded = read_frames(path, info=info, pix_fmt=pix_fmt)
-            frames = zip(range(len(planned.zoom)), decoded, strict=False)
-            for batch in batches(frames, WARP_BATCH if settings.device == "cuda" else 1):
+            kept = np.isin(np.arange(len(planned.zoom)), shown)
+
+            def frames() -> Iterator[tuple[int, NDArray]]:
+                nonlocal decoded_count
+                for k, frame in zip(range(len(planned.zoom)), decoded, strict=False):
+                    decoded_count += 1
+                    if kept[k]:
+                        yield k, frame
+                    else:  # left out where the container's players cannot show it
+                        progress(1)
+
+            for batch in batches(frames(), WARP_BATCH if settings.device == "cuda" else 1):
                 for frame, warped in zip(
                     (f for _, f in batch),
                     planned.warp_many(batch, settings.device, info.colour.full_range),
                     strict=True,
                 ):
-                    warped = shown(warped)
-                    writer.write(side_by_side(shown(frame), warped) if settings.preview else warped)
+                    warped = as_written(warped)
+                    writer.write(
+                        side_by_side(as_written(frame), warped) if settings.preview else warped
+                    )
                     written += 1
                     progress(1)
-            if written < len(planned.times) - 1:  # the frames after a gap would slip in time
+            if decoded_count < len(planned.times) - 1:  # the frames after a gap would slip
                 raise VideoError(
-                    f"{path}: {written} frames decoded, where pass 1 read {len(planned.times)}"
+                    f"{path}: {decoded_count} frames decoded, where pass 1 read "
+                    f"{len(planned.times)}"
                 )
         if variable:
-            times = planned.times[:written]
-            retime(target, out, times, container.muxer, mux.video_delay, container.options)
+            stamps = times[:written]
+            retime(target, out, stamps, container.muxer, mux.video_delay, container.options)
     finally:
         if variable:
             target.unlink(missing_ok=True)
@@ -117,6 +134,27 @@ def frame_size(info: VideoInfo, settings: Settings) -> tuple[int, int]:
     the smallest loss, and at the frame's edge, which the zoom crops anyway)."""
     h, w = settings.size or info.shown_framed_size
     return h - h % 2, w - w % 2
+
+
+def shown_frames(times: NDArray, container: Container) -> NDArray[np.intp]:
+    """The frames written into ``container``: all, but where its players show no frame
+    sooner than its ``min_interval`` after the last (GIF's 20 ms in browsers: a 60 fps
+    clip's every other frame, :func:`stabilize.video.retime.thinned`)."""
+    if not container.min_interval:
+        return np.arange(len(times))
+    return thinned(times, container.min_interval)
+
+
+def shown_notice(times: NDArray, container: Container) -> tuple[str, ...]:
+    """A notice where some frames are left out for the container's players."""
+    shown = len(shown_frames(times, container))
+    if shown == len(times):
+        return ()
+    return (
+        f"{container.name} frames shorter than {1000 * container.min_interval:.0f} ms are "
+        f"shown for 100 ms in browsers: {shown} of {len(times)} frames are written, each at "
+        "its own time",
+    )
 
 
 def piped_format(info: VideoInfo, settings: Settings) -> str:

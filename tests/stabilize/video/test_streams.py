@@ -296,6 +296,23 @@ def test_a_gif_keeps_every_frame_and_its_time_and_loops(attached, tmp_path):
     assert len(gaps) == 60 and max(gaps) < 4
 
 
+def test_a_gif_of_a_60_fps_clip_keeps_every_frame_browsers_show(shaky, tmp_path):
+    # its delays alternated 10 and 20 ms, and browsers show a 10 ms frame for 100 ms: the
+    # clip played at a third of its speed
+    fast = tmp_path / "fast.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-vf", "setpts=N/60/TB", "-r", "60"]
+    subprocess.run([*cmd, "-an", str(fast)], check=True)
+    out, n = tmp_path / "out.gif", len(frame_times(fast))
+    summary, _ = stabilize_video(fast, out, Settings(fov=70.0))
+    half = (n + 1) // 2  # every other frame, the first and the last among them
+    assert summary["frames"] == half and f"{half} of {n} frames" in " ".join(summary["notices"])
+    from PIL import Image
+
+    with Image.open(out) as gif:
+        delays = [gif.seek(k) or gif.info["duration"] for k in range(gif.n_frames)]
+    assert min(delays) >= 20 and sum(delays) == pytest.approx(half * 1000 / 30, abs=10)
+
+
 def test_a_gif_says_it_carries_alpha_only_where_it_declares_transparency(shaky, tmp_path):
     # FFmpeg decodes every GIF as bgra: an opaque one was said to lose its alpha
     opaque, clear = tmp_path / "opaque.gif", tmp_path / "clear.gif"
