@@ -23,7 +23,7 @@ counted).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import asdict, dataclass, field
 
 import cv2
@@ -279,11 +279,22 @@ def evaluate_against(
 ) -> tuple[ClipMetrics, list[ClipMetrics]]:
     """Metrics of the original and of each of several outputs of it (two tools', say),
     in one pass that reads the original once; each output's are those
-    :func:`evaluate_pair` gives it. Frames are taken in step; the shortest clip decides."""
+    :func:`evaluate_pair` gives it. Frames are taken in step; the shortest clip decides,
+    and a clip longer than it by more than a frame is a ValueError: its frames are not
+    the others' (a GIF of a 60 fps clip holds every other frame), and paired in step they
+    gave figures of frames shot at other times."""
     before, afters = _Clip(), [_Clip() for _ in outputs]
     scales: list[list[float]] = [[] for _ in outputs]
     ratios: list[list[float]] = [[] for _ in outputs]
-    for orig, *stabs in zip(original, *outputs, strict=False):
+    counts = [0] * (1 + len(outputs))
+
+    def counted(frames: Iterable[NDArray[np.uint8]], k: int) -> Iterator[NDArray[np.uint8]]:
+        for frame in frames:
+            counts[k] += 1
+            yield frame
+
+    clips = [counted(clip, k) for k, clip in enumerate((original, *outputs))]
+    for orig, *stabs in zip(*clips, strict=False):
         feat_orig = before.add(orig)
         for after, stab, scale_k, ratio_k in zip(afters, stabs, scales, ratios, strict=True):
             feat_stab = after.add(stab)
@@ -294,6 +305,16 @@ def evaluate_against(
             scale_k.append(scale)
             ratio_k.append(ratio)
         progress(1)
+    for clip in clips:  # what is left of the longer ones
+        for _ in clip:
+            pass
+    if max(counts) - min(counts) > 1:
+        said = ", ".join(f"{n} in output {k}" for k, n in enumerate(counts[1:], start=1))
+        said = said if len(outputs) > 1 else f"{counts[1]} in the stabilised clip"
+        raise ValueError(
+            f"the clips hold different frames ({counts[0]} in the original, {said}): frames "
+            "are compared in step, so each clip must hold every frame of the original"
+        )
     mine = [a.metrics(s, r, fps) for a, s, r in zip(afters, scales, ratios, strict=True)]
     return before.metrics([], [], fps), mine
 

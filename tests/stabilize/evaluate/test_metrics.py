@@ -88,6 +88,13 @@ def test_progress_is_told_of_every_pair_of_frames(shaken):
     assert told == [1] * 5
 
 
+def test_clips_of_other_frames_are_refused_not_paired_in_step(shaken):
+    # a GIF of a 60 fps clip holds every other frame: its figures were of frames paired
+    # with the original's shot at other times
+    with pytest.raises(ValueError, match=r"different frames \(12 in the original, 6 in the st"):
+        evaluate_pair(shaken[:12], shaken[:12:2])
+
+
 def test_registration_survives_featureless_frames():
     blank = [np.full((90, 160, 3), 128, np.uint8)] * 10
     _, m = evaluate_pair(blank, blank)
