@@ -169,10 +169,18 @@ def coarse_offset(
     first, last = float(times[0]), float(times[-1])
     if hi - lo >= MIN_COVERAGE * (last - first):
         step = 0.25 * frame_interval(times)
-        coarse = _best_offset(gyro, times, w_vis, np.arange(lo - first, hi - last + step, step))
+        everywhere = np.arange(lo - first, hi - last + step, step)
+        coarse = _best_offset(gyro, times, w_vis, everywhere)
         if np.isfinite(coarse[1]):
             fine = np.arange(coarse[0] - step, coarse[0] + step + 5e-4, 1e-3)
             return (*_best_offset(gyro, times, w_vis, fine), True)
+        if any(gyro.covers(times, delta) for delta in everywhere):
+            # it was said not to cover a 0.03 s video that its 20 s lay over
+            raise GyroError(
+                f"{gyro.log.source}: the gyro log covers the video, but its angular speed "
+                "and the video's do not vary enough to be matched (a camera held still, a "
+                "steady turn, or too few frames): give the offset, --gyro-offset SECONDS"
+            )
     raise GyroError(
         f"{gyro.log.source}: the gyro log, {lo:.2f}–{hi:.2f} s on its clock "
         f"({hi - lo:.2f} s), does not cover the video, {first:.2f}–{last:.2f} s "

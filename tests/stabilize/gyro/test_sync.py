@@ -247,3 +247,14 @@ def test_compare_reads_a_clip_held_upright_as_its_sensor_stored_it(tmp_path):
     wanted, got = json.loads(level.output), json.loads(held.output)
     assert got["readout_ms"] == wanted["readout_ms"] and got["readout_estimated"]
     assert got["aae_deg"] == wanted["aae_deg"] and got["R_cam_imu"] == wanted["R_cam_imu"]
+
+
+def test_a_log_whose_speeds_cannot_be_matched_asks_for_the_offset():
+    # a steady turn over two frames: it was said not to cover the video it lay over
+    from stabilize.gyro import GyroError
+    from stabilize.gyro.sync import IntervalRates, coarse_offset
+
+    log = GyroLog(np.arange(0.0, 20.0, 0.01), np.tile([0.1, 0.0, 0.0], (2000, 1)), "steady")
+    times = np.array([5.0, 5.0 + 1 / 30])
+    with pytest.raises(GyroError, match=r"covers the video, but .* --gyro-offset SECONDS"):
+        coarse_offset(IntervalRates(log), times, np.array([[0.1, 0.0, 0.0]]), (-1.0, 1.0))
