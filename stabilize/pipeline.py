@@ -131,6 +131,7 @@ def stabilize_video(
         lead = float(times[0])  # the frames lost at the start: the video starts late
         mux = replace(job.mux, video_delay=job.mux.video_delay + lead)
         job = replace(job, times=times - lead, mux=mux)
+        check_times(dst, job.times)  # its gaps make its rate vary: not into MXF
         tell(damage.notice)
         if lead > 0:
             tell(f"damaged: the first {lead:.2f} s of video do not decode: it starts there")

@@ -207,7 +207,10 @@ def speed_correlation(
     """Correlation of the visual and the gyro angular speeds (axis-free)."""
     speed = np.linalg.norm(gyro(times, offset, lag), axis=1)
     ok = np.isfinite(speed)
-    return float(np.corrcoef(np.linalg.norm(w_vis, axis=1)[ok], speed[ok])[0, 1])
+    a, b = np.linalg.norm(w_vis, axis=1)[ok], speed[ok]
+    if len(a) < 2 or np.ptp(a) == 0 or np.ptp(b) == 0:  # nothing varies: none (no warning)
+        return float("nan")
+    return float(np.corrcoef(a, b)[0, 1])
 
 
 def fit_axes(w_vis: NDArray, w_imu: NDArray, R: NDArray | None = None) -> tuple[NDArray, NDArray]:

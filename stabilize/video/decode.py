@@ -141,8 +141,9 @@ def frame_times(path: str | Path, input_args: tuple = (), *, decoded: bool = Fal
     times = _framecrc_times(path, input_args, decode=True) if decoded or listed is None else listed
     if times is None:
         raise VideoError(f"{path}: its frames carry no timestamps FFmpeg can read")
-    first = listed[0] if listed is not None and listed[0] <= times[0] else times[0]
-    return times - first
+    # lost frames leave a frame's time at the least; less is the decoded clock's rounding
+    lost = listed is not None and times[0] - listed[0] > 0.5 * frame_interval(listed)
+    return times - (listed[0] if lost else times[0])
 
 
 def frame_interval(times: np.ndarray) -> float:

@@ -46,7 +46,8 @@ def render(
     the source (default: nothing but the video); returns frames written.
 
     A variable-frame-rate clip is encoded at its nominal rate without B-frames, then its
-    packets are restamped with the source's own frame times (:func:`retime`).
+    packets are restamped with the source's own frame times (:func:`retime`). Frames the
+    container's players cannot show are left out (:func:`shown_frames`: a GIF's).
     """
     mux = mux or Mux()
     container = container_for(out)
