@@ -19,7 +19,7 @@ from stabilize.video.binary import drain, ffmpeg_exe, local, widen_pipe
 from stabilize.video.colour import UNKNOWN, Colour
 from stabilize.video.containers import Container, container_for
 from stabilize.video.encoders import FRAME_CLOCKED, encoder_args
-from stabilize.video.i420 import pipe_layout
+from stabilize.video.i420 import pipe_format, pipe_layout
 
 
 class EncodeError(RuntimeError):
@@ -94,7 +94,8 @@ def output_args(
     video started ``delay`` s late (:attr:`Mux.video_delay`)."""
     container = container or container_for(path)
     codec = encoding.codec_for(container)
-    args = [*encoder_args(codec, encoding.crf, encoding.preset), "-pix_fmt", encoding.pix_fmt]
+    deep = pipe_format(encoding.pix_fmt) != "yuv420p"  # 10 bits or more
+    args = [*encoder_args(codec, encoding.crf, encoding.preset, deep), "-pix_fmt", encoding.pix_fmt]
     if encoding.threads:
         args += ["-threads", str(encoding.threads)]
     if not encoding.b_frames:

@@ -3,7 +3,8 @@
 x264 and x265 take both as they are. The others get their own scales: VP9 constant
 quality needs ``-b:v 0``, and its speed is ``-cpu-used``; SVT-AV1 numbers its presets;
 an image sequence's JPEG takes a quantiser, and its PNG or TIFF neither (lossless); a GIF
-takes none (its palette is its quality).
+takes none (its palette is its quality), nor do the editing codecs, ProRes and DNxHR
+(a profile each, :data:`PROFILES`).
 An encoder not listed gets ``-crf`` and ``-preset`` as they are, and the pre-flight check
 (:func:`stabilize.video.preflight.check_encoder`) refuses what it does not take.
 """
@@ -82,8 +83,26 @@ ENCODERS: dict[str, Callable[[int, str], list[str]]] = {
 }
 
 
-def encoder_args(codec: str, crf: int | None, preset: str) -> list[str]:
-    """FFmpeg's arguments for ``codec`` at quality ``crf`` (None: the codec's default)."""
+# Editing codecs: no quality scale, a profile by the frames' depth (8 bits; 10 or more).
+# DNxHD's own profile took only broadcast sizes and bit rates ("video parameters
+# incompatible with DNxHD"); DNxHR takes any size, HQX alone at 10 bits. ProRes 422 HQ
+# (profile 3, both encoders), where prores_aw's default was Standard.
+PROFILES: dict[str, tuple[list[str], list[str]]] = {
+    "dnxhd": (["-profile:v", "dnxhr_hq"], ["-profile:v", "dnxhr_hqx"]),
+    "prores_ks": (["-profile:v", "3"], ["-profile:v", "3"]),
+    "prores_aw": (["-profile:v", "3"], ["-profile:v", "3"]),
+}
+
+
+def encoder_args(codec: str, crf: int | None, preset: str, deep: bool = False) -> list[str]:
+    """FFmpeg's arguments for ``codec`` at quality ``crf`` (None: the codec's default),
+    for frames of 10 bits or more where ``deep``.
+
+    >>> encoder_args("dnxhd", 18, "medium", deep=True)
+    ['-c:v', 'dnxhd', '-profile:v', 'dnxhr_hqx']
+    """
+    if codec in PROFILES:
+        return ["-c:v", codec, *PROFILES[codec][deep]]
     quality = DEFAULT_CRF.get(codec, 18) if crf is None else crf
     return ["-c:v", codec, *ENCODERS.get(codec, _x26x)(quality, preset)]
 
@@ -93,7 +112,8 @@ def unused_quality(codec: str, crf: int | None) -> tuple[str, ...]:
     TIFF keep every sample, a GIF's palette is its quality (``--crf`` was ignored
     silently)."""
     make = ENCODERS.get(codec, _x26x)
-    if crf is None or make(0, "medium") != make(63, "medium"):
+    if crf is None or (codec not in PROFILES and make(0, "medium") != make(63, "medium")):
         return ()
     why = "it keeps every sample" if make is _lossless else "its palette is its quality"
+    why = "its profile is its quality" if codec in PROFILES else why
     return (f"--crf {crf} has no effect on {codec}: {why}",)

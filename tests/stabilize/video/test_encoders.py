@@ -2,7 +2,9 @@
 
 import pytest
 
+from stabilize.video import Encoding
 from stabilize.video.encoders import encoder_args, unused_quality
+from stabilize.video.preflight import check_encoder
 
 
 def test_each_encoder_takes_the_quality_on_its_own_scale():
@@ -22,6 +24,7 @@ def test_each_encoder_takes_the_quality_on_its_own_scale():
         ("png", 10, "--crf 10 has no effect on png: it keeps every sample"),
         ("tiff", 0, "--crf 0 has no effect on tiff: it keeps every sample"),
         ("gif", 30, "--crf 30 has no effect on gif: its palette is its quality"),
+        ("prores_ks", 20, "--crf 20 has no effect on prores_ks: its profile is its quality"),
         ("png", None, None),  # not given: nothing to say
         ("libx264", 23, None),
         ("mjpeg", 23, None),
@@ -30,3 +33,13 @@ def test_each_encoder_takes_the_quality_on_its_own_scale():
 )
 def test_a_crf_with_no_effect_is_said(codec, crf, heard):
     assert unused_quality(codec, crf) == ((heard,) if heard else ())
+
+
+@pytest.mark.parametrize("codec", ["dnxhd", "prores_ks", "prores_aw"])
+@pytest.mark.parametrize("pix_fmt", ["yuv420p", "yuv420p10le"])
+def test_editing_codecs_take_any_size_at_either_depth(tmp_path, codec, pix_fmt):
+    # --codec dnxhd was refused at 320x180 ("video parameters incompatible with DNxHD"),
+    # and took -crf and -preset it has no use for
+    encoding = Encoding(codec=codec, pix_fmt=pix_fmt)
+    check_encoder(tmp_path / "out.mov", encoding, (180, 320))
+    check_encoder(tmp_path / "out.mxf", encoding, (180, 320), 25.0)
