@@ -318,6 +318,8 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     order, colour = _from_frames(path, input_args, pix_fmt, video.group(3) or "")
     colour = replace(colour, dolby_vision=dolby_vision(_listing(text, video.start())))
     streams = tuple(_stream(m, text) for m in _STREAM.finditer(text))
+    if all(s.cover for s in streams if s.kind == "video"):  # a song's: "has 1 frame(s)"
+        raise VideoError(f"{path}: has no video stream, only audio and a cover picture")
     has_audio = any(s.kind == "audio" for s in streams)
     start = _START.search(text)
     return VideoInfo(
