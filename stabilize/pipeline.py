@@ -71,6 +71,7 @@ from stabilize.video.streams import keep_streams
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.lens import Lens, read_lens_profile
 from stabilize.warp.render import (
+    check_shape,
     encoded_size,
     frame_size,
     output_encoding,
@@ -202,6 +203,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     # the sensor's rows, whichever way the camera was held; its fields woven into frames
     info = probe(src, sequence_args(src, fps=settings.fps))
     info = info.stored().deinterlaced(settings.deinterlace)
+    check_shape(info, settings)
     check_writable(dst)
     container = container_for(dst)
     encoding = output_encoding(info, settings, container)

@@ -137,6 +137,22 @@ def frame_size(info: VideoInfo, settings: Settings) -> tuple[int, int]:
     return h - h % 2, w - w % 2
 
 
+def check_shape(info: VideoInfo, settings: Settings, tolerance: float = 0.01) -> None:
+    """ValueError where ``--size`` is not the picture's shape (beyond ``tolerance`` of
+    its aspect ratio): it was stretched to it, a phone's upright 720x1280 clip to 1280x720.
+    """
+    if not settings.size:
+        return
+    (h, w), (sh, sw) = settings.size, info.shown_framed_size
+    if abs((w / h) / (sw / sh) - 1.0) <= tolerance:
+        return
+    wide, tall = 2 * round(w * sh / sw / 2), 2 * round(h * sw / sh / 2)
+    raise ValueError(
+        f"--size {w}x{h} would stretch the {sw}x{sh} picture: give its shape, e.g. "
+        f"{w}x{wide} or {tall}x{h}"
+    )
+
+
 def shown_frames(times: NDArray, container: Container) -> NDArray[np.intp]:
     """The frames written into ``container``: all, but where its players show no frame
     sooner than its ``min_interval`` after the last (GIF's 20 ms in browsers: a 60 fps

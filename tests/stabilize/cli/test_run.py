@@ -95,3 +95,8 @@ def test_output_size(shaky, tmp_path):
     assert probe(out).size == (90, 160) and len(frame_times(out)) == 60
     bad = RUNNER.invoke(app, ["run", str(shaky), str(tmp_path / "x.mp4"), "--size", "big"])
     assert bad.exit_code != 0 and "WIDTHxHEIGHT" in bad.output
+    # another shape was stretched to: a phone's upright clip to 1280x720
+    tall = RUNNER.invoke(app, ["run", str(shaky), str(tmp_path / "x.mp4"), "--size", "90x160"])
+    assert tall.exit_code == 2 and "would stretch the 320x180 picture: give its shape, e.g. " \
+        "90x50 or 284x160" in tall.output  # fmt: skip
+    assert not (tmp_path / "x.mp4").exists()
