@@ -12,6 +12,7 @@ left as it is.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import hashlib
 import json
@@ -223,6 +224,7 @@ def _start_worker(threads: int, frames) -> None:
     global _FRAMES
     _FRAMES = frames
     signal.signal(signal.SIGTERM, _interrupt)
+    os.setpgrp()  # a group of its own, with its FFmpeg processes: stopped together
     for var in THREAD_VARS:
         os.environ[var] = str(threads)
     import cv2
@@ -241,6 +243,10 @@ def _pooled_job(job: Job, settings) -> dict:
     try:
         return run_job(job, settings)
     except KeyboardInterrupt:
+        # with any FFmpeg an interrupt left running (one that struck while it started
+        # wrote its file after the job had removed it): the worker leads its own group
+        with contextlib.suppress(OSError):
+            os.killpg(os.getpid(), signal.SIGKILL)
         os._exit(STOPPED)
 
 
@@ -367,11 +373,15 @@ def run_batch(
         if ray_address
         else _execute(todo, settings, workers or default_workers(), on_frames)
     )
-    for row in rows_in:
-        rows[row["input"]] = row
-        write_manifest(out_dir, {**previous, **started, **rows})
-        if on_done:
-            on_done(row)
+    try:
+        for row in rows_in:
+            rows[row["input"]] = row
+            write_manifest(out_dir, {**previous, **started, **rows})
+            if on_done:
+                on_done(row)
+    except BaseException:  # stopped: what its stopped workers left, once they are gone
+        sweep_stale(out_dir, recursive=True)
+        raise
     return [rows[job.input] for job in jobs]
 
 

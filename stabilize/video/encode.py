@@ -163,8 +163,13 @@ class FrameWriter:
         cmd += [*output_args(path, encoding, container, mux.video_delay), *colour.ffmpeg_args()]
         cmd += [*colour.hdr10_args(codec), local(path, container.pictures is not None)]
         self._process = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
-        self._said = drain(self._process.stderr)  # (a damaged source's audio says much)
-        widen_pipe(self._process.stdin)
+        try:
+            self._said = drain(self._process.stderr)  # (a damaged source's audio says much)
+            widen_pipe(self._process.stdin)
+        except BaseException:  # an interrupt before `with` takes it: FFmpeg left running
+            self._process.kill()  # wrote its file after the caller had removed it
+            self._process.wait()
+            raise
 
     def write(self, frame: NDArray[np.uint8]) -> None:
         if frame.shape != self.shape or frame.dtype != self.dtype:
