@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import ctypes
 import hashlib
 import json
 import multiprocessing as mp
@@ -225,11 +226,26 @@ def _start_worker(threads: int, frames) -> None:
     _FRAMES = frames
     signal.signal(signal.SIGTERM, _interrupt)
     os.setpgrp()  # a group of its own, with its FFmpeg processes: stopped together
+    _end_with_parent()
     for var in THREAD_VARS:
         os.environ[var] = str(threads)
     import cv2
 
     cv2.setNumThreads(threads)
+
+
+PR_SET_PDEATHSIG = 1  # Linux's prctl option: a signal for when the parent ends
+
+
+def _end_with_parent() -> None:
+    """SIGTERM to this worker when the batch ends, however it ends (SIGKILL included),
+    now that a signal to the batch's process group no longer reaches it (Linux; where
+    there is no prctl, a worker ends once its file is done and it finds the batch gone)."""
+    parent = os.getppid()
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+    if os.getppid() != parent:  # it ended before the request was made
+        os.kill(os.getpid(), signal.SIGTERM)
 
 
 def _interrupt(_signum: int, _frame) -> None:
