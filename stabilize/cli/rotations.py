@@ -94,18 +94,19 @@ def rotations(
     track, focal = run_or_fail(lambda: with_bars(estimate, quiet=quiet))
     across = f"{focal.fov_deg:.1f}° across the long side"
     notice(f"focal length {focal.px:.1f} px ({across}, {focal.source})")
+
+    def write(target: Path, writer) -> None:
+        """``writer`` into standard output (``-``), else into ``target`` atomically."""
+        if target == STDOUT:
+            writer(sys.stdout)
+            return
+        with atomic_output(target, overwrite=overwrite) as tmp:
+            writer(tmp)
+
     if output is not None:
-        rows = (track.times[:-1], so3.log_so3(track.rotations), track.support)
-        if output == STDOUT:
-            write_rotations(sys.stdout, *rows)
-        else:
-            with atomic_output(output, overwrite=overwrite) as tmp:
-                write_rotations(tmp, *rows)
+        rotvecs = so3.log_so3(track.rotations)
+        write(output, lambda to: write_rotations(to, track.times[:-1], rotvecs, track.support))
     if gcsv is not None:
         from stabilize.gyro.export import write_gcsv
 
-        if gcsv == STDOUT:
-            write_gcsv(sys.stdout, track.times, track.rotations)
-        else:
-            with atomic_output(gcsv, overwrite=overwrite) as tmp:
-                write_gcsv(tmp, track.times, track.rotations)
+        write(gcsv, lambda to: write_gcsv(to, track.times, track.rotations))
