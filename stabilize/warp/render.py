@@ -57,9 +57,9 @@ def render(
     size = encoded_size(info, settings)
     shown = shown_frames(planned.times, container)
     times = planned.times[shown]
-    if len(times) < len(planned.times) and not is_variable_rate(times):  # every k-th frame
-        fps = (len(times) - 1) / (times[-1] - times[0])
     variable = container.timed and is_variable_rate(times)
+    if len(times) < len(planned.times) and not variable:  # every k-th frame
+        fps = (len(times) - 1) / (times[-1] - times[0])
     pix_fmt = piped_format(info, settings)
     planar = pix_fmt != "rgb24"
     encoding = replace(encoding, b_frames=False) if variable else encoding
@@ -146,10 +146,10 @@ def check_shape(info: VideoInfo, settings: Settings, tolerance: float = 0.01) ->
     (h, w), (sh, sw) = settings.size, info.shown_framed_size
     if abs((w / h) / (sw / sh) - 1.0) <= tolerance:
         return
-    wide, tall = 2 * round(w * sh / sw / 2), 2 * round(h * sw / sh / 2)
+    h_for_w, w_for_h = 2 * round(w * sh / sw / 2), 2 * round(h * sw / sh / 2)
     raise ValueError(
         f"--size {w}x{h} would stretch the {sw}x{sh} picture: give its shape, e.g. "
-        f"{w}x{wide} or {tall}x{h}"
+        f"{w}x{h_for_w} or {w_for_h}x{h}"
     )
 
 
