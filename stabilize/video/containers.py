@@ -61,6 +61,9 @@ class Container:
     # Whether it keeps each frame's own time (a variable rate): MXF holds one edit rate
     variable_rate: bool = True
     audio_rate: int | None = None  # the one sample rate its audio takes (Hz; None: any)
+    # The most frames from one keyframe to the next (None: the encoder's own): an encoder
+    # option, not the muxer's, so not among ``options``, which a remux hands the muxer
+    keyframes: int | None = None
     # The least time between frames as its players show them (s; 0: none): browsers show
     # a GIF frame of 0 or 10 ms for 100 ms, so a 60 fps clip played at a third its speed
     min_interval: float = 0.0
@@ -165,7 +168,7 @@ MXF = Container(
     audio_rate=48_000,
     subtitles=frozenset(),
     chapters=False,
-    options=("-g", "120"),
+    keyframes=120,
     timecode="track",  # its own timecode track
     variable_rate=False,
     name="MXF",

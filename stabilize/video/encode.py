@@ -100,6 +100,8 @@ def output_args(
         args += ["-threads", str(encoding.threads)]
     if not encoding.b_frames:
         args += ["-bf", "0"]
+    if container.keyframes:
+        args += ["-g", str(container.keyframes)]
     if container.hevc_tag and codec in ("libx265", "hevc"):
         args += ["-tag:v", container.hevc_tag]
     fine = container.fine_clock and codec not in FRAME_CLOCKED
