@@ -191,6 +191,8 @@ _START = re.compile(r"Duration: [^\n]*?start: (-?\d+(?:\.\d+)?)")
 _STREAM = re.compile(
     r"Stream #0:(\d+)(?:\[\w+\])?(?:\((\w+)\))?: (Video|Audio|Subtitle|Data|Attachment): (\w+)"
 )
+# A URL's scheme, its "//" read as one "/" once it has been a Path
+_URL = re.compile(r"([A-Za-z][A-Za-z0-9+.-]+):/+")
 _SAR = re.compile(r"\[SAR (\d+):(\d+) DAR")
 _ROTATION = re.compile(r"rotation of (-?\d+(?:\.\d+)?) degrees|rotate\s*:\s*(-?\d+)")
 
@@ -263,6 +265,12 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     pattern = is_pattern(path)
     input_args = input_args or sequence_args(path)  # a sequence's first number, at 30 fps
     path = Path(path)
+    if not pattern and not path.exists() and (url := _URL.match(str(path))):
+        # FFmpeg would stream it, but a clip is read three times (probe, two passes):
+        # downloaded three times, and a live stream's passes would see different frames
+        raise VideoError(
+            f"{url.group(1)}://{str(path)[url.end() :]}: a URL: download the clip first"
+        )
     if not pattern and not path.exists():
         raise VideoError(f"{path}: no such file")
     if pattern and (first := first_image(input_args)) is None:

@@ -74,3 +74,13 @@ def test_a_pipe_for_the_clip_is_refused_before_it_waits(tmp_path, monkeypatch, c
         .err.strip()
         .endswith("is a pipe or a device, not a file: save the clip first")
     )
+
+
+@pytest.mark.parametrize("url", ["https://example.com/clip.mp4", "rtmp://example.com/live"])
+def test_a_url_for_the_clip_is_named_as_one(monkeypatch, capsys, url):
+    # the path's "//" became "/" and the URL was said to be a missing file
+    monkeypatch.setattr("sys.argv", ["stabilize", url, "out.mp4"])
+    with pytest.raises(SystemExit) as done:
+        main()
+    assert done.value.code == 2
+    assert capsys.readouterr().err.strip() == f"error: {url}: a URL: download the clip first"
