@@ -11,6 +11,7 @@ working size with :func:`flow.working_size` (about 480 px on the long side).
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 
 from flow.base import FlowBackend
@@ -27,11 +28,12 @@ def _raft(variant: str) -> Callable[..., FlowBackend]:
     return make
 
 
+# The learned backends: a name → its RAFT variant, whose checkpoint it loads
+RAFT_VARIANTS = {"raft": "small", "raft-large": "large"}
 # The registry: a backend's name → its factory. Adding one is one line here.
 BACKENDS: dict[str, Callable[..., FlowBackend]] = {
     "dis": DISFlow,
-    "raft": _raft("small"),
-    "raft-large": _raft("large"),
+    **{name: _raft(variant) for name, variant in RAFT_VARIANTS.items()},
 }
 
 
@@ -46,4 +48,23 @@ def get(name: str = "dis", **options) -> FlowBackend:
     return BACKENDS[name](**options)
 
 
-__all__ = ["BACKENDS", "DISFlow", "FlowBackend", "WorkingSize", "get", "working_size"]
+def check_weights(name: str, weights: str | os.PathLike | None = None) -> None:
+    """``FileNotFoundError`` where backend ``name`` would find no checkpoint, loading
+    no model: a batch checks once, before its workers start (a CUDA context made before
+    they fork would not work in them)."""
+    if name in RAFT_VARIANTS:
+        from flow.raft.weights import find_weights
+
+        find_weights(RAFT_VARIANTS[name], weights)
+
+
+__all__ = [
+    "BACKENDS",
+    "RAFT_VARIANTS",
+    "DISFlow",
+    "FlowBackend",
+    "WorkingSize",
+    "check_weights",
+    "get",
+    "working_size",
+]

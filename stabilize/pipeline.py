@@ -42,7 +42,7 @@ from stabilize.path.residual import MOTION_MODELS
 from stabilize.path.smoothing import METHODS
 from stabilize.path.zoom import CROP_MODES
 from stabilize.progress import ProgressFactory, no_progress
-from stabilize.settings import Settings
+from stabilize.settings import LENS_WITH_FOCAL, Settings
 from stabilize.video import VideoInfo, atomic_output, frame_interval, frame_times, probe
 from stabilize.video.atomic import check_absent, check_not_input, is_sequence
 from stabilize.video.bars import BARS_MODES, detect_bars
@@ -516,6 +516,7 @@ def check_settings(settings: Settings) -> None:
             "--fov must be 0–180° or auto",
         ),
         (settings.focal is None or settings.focal > 0, "--focal must be a positive number"),
+        (settings.lens is None or not settings.fov_given, LENS_WITH_FOCAL),
         (settings.smooth > 0, "--smooth must be positive"),
         (settings.max_zoom >= 1.0, "--max-zoom must be at least 1"),
         (settings.gyro_search >= 0, "--gyro-search must not be negative"),

@@ -16,6 +16,9 @@ from stabilize.video.encode import Encoding
 # would model a 9:16 clip's camera 1.78× too wide, the costly direction (a wrong f's
 # keystone grows with |1/f'² - 1/f²|)
 DEFAULT_FOV = 69.0
+# A lens profile brings its focal length: estimated at a given --fov while warped through
+# the profile's, a clip was estimated and warped with two different cameras
+LENS_WITH_FOCAL = "--lens brings its own focal length: give it without --fov or --focal"
 # Crop at most 13% of each side: about what FFmpeg's vid.stab zooms to (optzoom=1). Where
 # removing all the shake would need more, the path keeps as little of it as a linear
 # programme finds (:mod:`stabilize.path.optimal`).

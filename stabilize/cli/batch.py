@@ -112,14 +112,22 @@ def batch(
     """Stabilise every clip in a folder: resumable, one failure never stops the rest."""
     from rich.console import Console
 
+    import flow
     from stabilize.batch import run_batch
     from stabilize.cli.bars import batch_progress
+    from stabilize.pipeline import check_settings
+    from stabilize.warp.lens import read_lens_profile
 
     if not in_dir.is_dir():
         fail(f"{in_dir}: not a folder")
     if gyro not in (None, "auto"):
         fail("--gyro in batch mode takes 'auto' (a sidecar log per clip)")
     settings = job_settings(ctx.params)
+    # once, before the files: each failed alike with the same message
+    run_or_fail(lambda: check_settings(settings))
+    if lens is not None:  # whether it can be read; whether it fits a clip is that clip's
+        run_or_fail(lambda: read_lens_profile(lens))
+    run_or_fail(lambda: flow.check_weights(flow_name, raft_weights))
     jobs = _jobs(ctx.params, settings)
     announce_compiling()
     console = Console(stderr=True)

@@ -34,7 +34,7 @@ from stabilize.cli.options import (
     readout,
 )
 from stabilize.progress import ProgressFactory
-from stabilize.settings import DEFAULTS
+from stabilize.settings import DEFAULTS, LENS_WITH_FOCAL
 from stabilize.video.probe import VideoInfo
 
 
@@ -135,6 +135,8 @@ def _comparison(params: dict, bar: ProgressFactory):
     settings = flow_settings(
         flow_name, weights, "cpu", fov=field_of_view(fov), focal=focal, max_deg=15.0
     )
+    if params["lens"] and settings.fov_given:
+        raise ValueError(LENS_WITH_FOCAL)
     R_cam_imu = axes_matrix(params["gyro_axes"])
     calibrate = params["calibrate_focal"]
     log = read_gyro(params["gyro"], params["gyro_format"])

@@ -52,7 +52,10 @@ FocalOption = Annotated[
 ]
 LensOption = Annotated[
     Path | None,
-    typer.Option(help="Gyroflow lens profile (.json, OpenCV fisheye): overrides --fov/--focal."),
+    typer.Option(
+        help="Gyroflow lens profile (.json, OpenCV fisheye), with its own focal length "
+        "(not with --fov or --focal)."
+    ),
 ]
 SmoothOption = Annotated[float, typer.Option(min=0.01, help="Smoothing time constant, s.")]
 MethodOption = Annotated[

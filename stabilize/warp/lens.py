@@ -43,9 +43,10 @@ class Lens:
     source: str = ""
 
 
-def read_lens_profile(path: str | Path, size: tuple[int, int]) -> Lens:
+def read_lens_profile(path: str | Path, size: tuple[int, int] | None = None) -> Lens:
     """A Gyroflow lens profile, scaled to a video of (H, W) pixels as its sensor stores
-    them (:meth:`stabilize.video.VideoInfo.stored`), the frames it was calibrated on."""
+    them (:meth:`stabilize.video.VideoInfo.stored`), the frames it was calibrated on;
+    without ``size``, at the size it was calibrated at (a check before a batch's clips)."""
     path = Path(path)
     try:
         profile = json.loads(path.read_text())
@@ -66,7 +67,7 @@ def read_lens_profile(path: str | Path, size: tuple[int, int]) -> Lens:
         raise LensError(f"{path}: missing or malformed lens field {err}") from None
     if coeffs.size != 4 or not np.isfinite(K).all() or K[0, 0] <= 0 or cw <= 0 or ch <= 0:
         raise LensError(f"{path}: needs a camera matrix, 4 fisheye coefficients and a size")
-    h, w = size
+    h, w = size or (ch, cw)
     if abs((w / h) / (cw / ch) - 1.0) > 0.01:
         raise LensError(
             f"{path}: calibrated at {cw:.0f}x{ch:.0f}, a different aspect ratio from the "

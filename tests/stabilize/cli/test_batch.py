@@ -24,6 +24,23 @@ def test_an_output_folder_holding_the_input_folder_is_refused(tmp_path):
         assert result.exit_code == 2 and "the output folder holds the input folder" in result.output
 
 
+def test_options_that_would_fail_every_clip_are_refused_before_any(tmp_path):
+    # each clip failed in turn with the same message, and the batch exited 0
+    (tmp_path / "in").mkdir()
+    (tmp_path / "in" / "a.mp4").write_bytes(SAMPLE.read_bytes())
+    (tmp_path / "bad.json").write_text("{not json")
+    cases = {
+        "no such lens profile": ["--lens", str(tmp_path / "nope.json")],
+        "not a Gyroflow lens profile": ["--lens", str(tmp_path / "bad.json")],
+        "RAFT weights not found": ["--flow", "raft", "--raft-weights", str(tmp_path / "no.pth")],
+    }
+    for message, options in cases.items():
+        args = ["batch", str(tmp_path / "in"), str(tmp_path / "out"), *options]
+        result = CliRunner().invoke(app, args)
+        assert result.exit_code == 2 and message in result.output, result.output
+    assert not (tmp_path / "out").exists()
+
+
 def test_batch_takes_every_option_of_the_single_file_command():
     commands = typer.main.get_command(app).commands
     names = {name: {p.name for p in commands[name].params} for name in ("run", "batch")}

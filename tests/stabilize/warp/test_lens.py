@@ -7,10 +7,12 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
 from rotation import so3
 from rotation.camera import intrinsics
 from stabilize import Settings, estimate_rotations, stabilize_video
+from stabilize.cli import app
 from stabilize.motion.files import read_rotations
 from stabilize.pipeline import prepare
 from stabilize.video import FrameWriter, probe, read_frames
@@ -147,6 +149,39 @@ def test_fisheye_rotations_are_estimated_through_the_lens(fisheye_clip):
     err_pinhole = so3.angular_error_deg(as_pinhole.rotations, R_true).mean()
     # As accurate as on the pinhole original (0.035°); the lens ignored costs 0.015° more.
     assert err_lens < 0.045 and err_pinhole > err_lens + 0.01
+
+
+def test_the_rotations_command_reads_the_flow_through_the_lens(fisheye_clip, tmp_path):
+    # rotations had no --lens: a fisheye clip's rotations were a pinhole's
+    clip, lens_path = fisheye_clip
+    out = tmp_path / "rot.csv"
+    args = ["rotations", str(clip), "-o", str(out), "-q", "--lens", str(lens_path)]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert "focal length 560.0 px" in result.output and "lens)" in result.output
+    truth = read_rotations(SAMPLE / "truth.csv")
+    found = read_rotations(out)
+    R_true = so3.exp_so3(np.array([truth[k] for k in range(89)]))
+    R = so3.exp_so3(np.array([found[k] for k in range(89)]))
+    assert so3.angular_error_deg(R, R_true).mean() < 0.045
+
+
+@pytest.mark.parametrize("command", ["run", "rotations", "compare", "batch"])
+def test_a_lens_with_a_focal_length_too_is_refused(tmp_path, command):
+    # run estimated at --fov's focal length while it warped at the profile's
+    lens = profile(tmp_path / "lens.json")
+    out = str(tmp_path / "out")
+    args = {
+        "run": [str(SAMPLE / "clip.mp4"), out + ".mp4"],
+        "rotations": [str(SAMPLE / "clip.mp4"), "-o", out + ".csv"],
+        "compare": [str(SAMPLE / "clip.mp4"), "--gyro", str(SAMPLE / "gyro.csv")],
+        "batch": [str(SAMPLE), out],
+    }[command]
+    for focal in (["--fov", "60"], ["--focal", "500"]):
+        result = CliRunner().invoke(app, [command, *args, "--lens", str(lens), *focal])
+        assert result.exit_code == 2
+        assert "error: --lens brings its own focal length" in result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["lens.json"]
 
 
 def test_stabilising_a_fisheye_clip_with_its_lens_profile(fisheye_clip, tmp_path):
