@@ -90,7 +90,7 @@ CodecOption = Annotated[
     typer.Option(
         help="Video encoder (any FFmpeg has): default libx264, or libx265 for a source of "
         "10 bits or more (H.264 at 10 bits plays in few players), libvpx-vp9 for .webm, gif "
-        "for .gif, mpeg2video for .mpg and .vob; "
+        "for .gif, mpeg2video for .mpg and .vob, libtheora for .ogv; "
         "libx265 for HEVC, libsvtav1 for AV1."
     ),
 ]

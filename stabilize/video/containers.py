@@ -228,6 +228,18 @@ CONTAINERS: dict[str, Container] = {
     ".mpeg": MPEG_PS,
     ".vob": MPEG_PS,
     ".mxf": MXF,
+    # Ogg video, as Firefox plays it: Theora (x264's H.264 it cannot hold) and Vorbis.
+    # Theora counts frames at one rate: a variable rate's remux failed ("theora")
+    ".ogv": Container(
+        "ogg",
+        "libtheora",
+        frozenset({"vorbis", "opus", "flac"}),
+        "libvorbis",
+        frozenset(),
+        chapters=False,
+        variable_rate=False,
+        name="Ogg",
+    ),
     ".gif": animation(
         "gif", "gif", pix_fmt="pal8", video_filter=GIF_PALETTE, min_interval=0.02, name="GIF"
     ),

@@ -25,6 +25,8 @@ VIDEO_ONLY = frozenset({"libx264", "libx265", "libvpx-vp9", "libsvtav1", "libaom
 # JPEG's and MPEG-2's quantiser (-q:v, 1 best to 31) per step of x264's CRF: 18 gives 2,
 # the usual choice for frames kept for analysis, and a DVD's best
 CRF_PER_JPEG_Q = 9
+# Theora's quality (-q:v, 0 to 10, best last) falls by one per this many steps of CRF
+CRF_PER_THEORA_Q = 9
 # Encoders whose time base must be a frame rate their standard lists: a 90 kHz clock
 # (a delayed video's, :func:`stabilize.video.encode.output_args`) does not open them
 FRAME_CLOCKED = frozenset({"mpeg1video", "mpeg2video"})
@@ -59,6 +61,13 @@ def _jpeg(crf: int, preset: str) -> list[str]:
     return ["-q:v", str(min(max(round(crf / CRF_PER_JPEG_Q), 1), 31))]
 
 
+def _theora(crf: int, preset: str) -> list[str]:
+    # a quality of 0 to 10, best last. x264's CRF 18 gives 8: on a rendered 4 s 320x180
+    # clip 38.5 dB PSNR at 2.6x the size of x264's 41.0 dB; Theora's best, 10 (CRF 0),
+    # reads 40.7 dB at 4x
+    return ["-q:v", str(min(max(round(10 - crf / CRF_PER_THEORA_Q), 0), 10))]
+
+
 def _lossless(crf: int, preset: str) -> list[str]:
     return []  # PNG and TIFF keep every sample: no quality to choose
 
@@ -77,6 +86,7 @@ ENCODERS: dict[str, Callable[[int, str], list[str]]] = {
     "mjpeg": _jpeg,
     "mpeg2video": _jpeg,  # a quantiser, as JPEG's: MPEG-2 has no constant quality
     "mpeg1video": _jpeg,
+    "libtheora": _theora,
     "png": _lossless,
     "tiff": _lossless,
     "gif": _gif,

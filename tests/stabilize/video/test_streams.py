@@ -14,6 +14,7 @@ import pytest
 from stabilize import Settings, stabilize_video
 from stabilize.video import Encoding, FrameWriter, ffmpeg_exe, frame_times, probe, read_frames
 from stabilize.video.containers import container_for
+from stabilize.video.preflight import OutputError, check_times
 from stabilize.video.streams import keep_streams
 from tests.stabilize.helpers import SAMPLE
 
@@ -394,6 +395,25 @@ def test_mxf_takes_a_long_clip_and_its_audio_as_48_khz_pcm(rich, tmp_path):
         assert [(a.codec_context.name, a.sample_rate) for a in audio] == [("pcm_s24le", 48000)] * 2
     with av.open(str(long)) as c:
         assert sum(1 for packet in c.demux(c.streams.video[0]) if packet.size) == 140
+
+
+def test_ogv_writes_theora_and_vorbis(rich, tmp_path):
+    # x264's H.264 was refused by the Ogg muxer ("Unsupported codec id in stream 0")
+    info, out = probe(rich["mp4"]), tmp_path / "out.ogv"
+    mux = keep_streams(info, container_for(out))
+    assert "audio #1: aac → libvorbis for Ogg" in mux.notices
+    assert "left out subtitle #3 (mov_text): Ogg cannot hold it" in mux.notices
+    with FrameWriter(out, (64, 64), 30.0, Encoding(), mux) as writer:
+        for _ in range(30):
+            writer.write(np.zeros(writer.shape, writer.dtype))
+    with av.open(str(out)) as c:
+        assert c.streams.video[0].codec_context.name == "theora"
+        assert [a.codec_context.name for a in c.streams.audio] == ["vorbis"] * 2
+        assert [a.language for a in c.streams.audio] == ["eng", "fra"]
+    assert len(frame_times(out)) == 30  # (a repeated frame is an empty packet in Theora)
+    times = np.r_[np.arange(10) / 30, 0.4 + np.arange(10) / 10]  # a phone's varying rate
+    with pytest.raises(OutputError, match="Ogg holds one constant frame rate"):
+        check_times(out, times)
 
 
 def test_mxf_writes_the_timecode_in_its_own_track(timecoded, tmp_path):
