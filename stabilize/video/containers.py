@@ -18,6 +18,9 @@ from pathlib import Path
 # Text subtitle codecs (FFmpeg's names): these convert into one another.
 TEXT_SUBTITLES = frozenset({"mov_text", "subrip", "srt", "ass", "ssa", "webvtt", "text"})
 QUICKTIME_AUDIO = frozenset({"aac", "mp3", "alac", "ac3", "eac3", "opus", "flac"})
+# The most channels an audio encoder takes where it is fewer than eight (FFmpeg mixes a
+# track of more down to its most): AC-3 holds 5.1, as DVDs carry it
+MAX_CHANNELS = {"libmp3lame": 2, "mp2": 2, "ac3": 6}
 QUICKTIME = ("-movflags", "+faststart+use_metadata_tags")  # moov first; keep custom tags
 
 
@@ -64,6 +67,9 @@ class Container:
     # The most frames from one keyframe to the next (None: the encoder's own): an encoder
     # option, not the muxer's, so not among ``options``, which a remux hands the muxer
     keyframes: int | None = None
+    # The encoder for audio of more channels than ``audio_encoder`` takes (None: that
+    # one): MP3's and MP2's take two, and downmixed a 5.1 track to stereo
+    surround_encoder: str | None = None
     # The least time between frames as its players show them (s; 0: none): browsers show
     # a GIF frame of 0 or 10 ms for 100 ms, so a 60 fps clip played at a third its speed
     min_interval: float = 0.0
@@ -73,10 +79,14 @@ class Container:
         """Whether it keeps frame times: an image sequence keeps none."""
         return self.pictures is None
 
-    def audio_codec(self, codec: str) -> str | None:
-        """``copy`` for an audio codec held as it is, else the encoder it becomes (None:
-        it cannot be held)."""
-        return "copy" if self.audio is None or codec in self.audio else self.audio_encoder
+    def audio_codec(self, codec: str, channels: int = 0) -> str | None:
+        """``copy`` for an audio codec held as it is, else the encoder a track of
+        ``channels`` becomes (None: it cannot be held)."""
+        if self.audio is None or codec in self.audio:
+            return "copy"
+        if self.surround_encoder and channels > MAX_CHANNELS.get(self.audio_encoder or "", 8):
+            return self.surround_encoder
+        return self.audio_encoder
 
     def subtitle_codec(self, codec: str) -> str | None:
         """``copy``, the encoder a text subtitle becomes, or None: it cannot be held."""
@@ -150,6 +160,7 @@ MPEG_PS = Container(
     "mpeg2video",
     audio=frozenset({"mp2", "mp3", "ac3", "pcm_dvd"}),
     audio_encoder="mp2",
+    surround_encoder="ac3",
     subtitles=frozenset({"dvd_subtitle"}),
     chapters=False,
     pix_fmt="yuv420p",
@@ -207,6 +218,7 @@ CONTAINERS: dict[str, Container] = {
         "avi",
         audio=frozenset({"mp3", "mp2", "ac3", "pcm_s16le"}),  # not ADTS AAC
         audio_encoder="libmp3lame",
+        surround_encoder="ac3",
         subtitles=frozenset(),
         chapters=False,
     ),

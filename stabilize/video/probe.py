@@ -45,6 +45,7 @@ class Stream:
     timecode: str = ""  # SMPTE start timecode (HH:MM:SS:FF), where the stream carries one
     cover: bool = False  # a cover picture (FFmpeg's "attached pic"): one still, not a video
     filename: str = ""  # an attached file's name (a font's, in Matroska)
+    channels: int = 0  # an audio track's channels (0: not audio, or not listed)
 
 
 @dataclass(frozen=True)
@@ -229,6 +230,7 @@ def _stream(match: re.Match, text: str) -> Stream:
     tag = re.search(r"\((\w+) / 0x[0-9A-Fa-f]+\)", line)
     timecode = re.search(r"^\s+timecode\s*: (\S+)", block, re.M | re.I)  # MKV: TIMECODE
     filename = re.search(r"^\s+filename\s*: (.*)$", block, re.M | re.I)
+    layout = re.search(r" Hz, ([^,]+),", line)
     return Stream(
         int(match.group(1)),
         match.group(3).lower(),
@@ -240,7 +242,27 @@ def _stream(match: re.Match, text: str) -> Stream:
         timecode.group(1) if timecode else "",
         "(attached pic)" in line,
         filename.group(1).strip() if filename else "",
+        channel_count(layout.group(1)) if layout else 0,
     )
+
+
+# FFmpeg's names of channel layouts that give no count in figures
+NAMED_LAYOUTS = {"mono": 1, "stereo": 2, "downmix": 2, "binaural": 2, "quad": 4,
+                 "hexagonal": 6, "octagonal": 8, "cube": 8, "hexadecagonal": 16}  # fmt: skip
+
+
+def channel_count(layout: str) -> int:
+    """The channels of an audio layout as FFmpeg lists it (0: a name it does not know).
+
+    >>> [channel_count(n) for n in ("stereo", "5.1(side)", "7.1", "quad(side)", "3 channels")]
+    [2, 6, 8, 4, 3]
+    """
+    layout = layout.strip()
+    if figures := re.fullmatch(r"(\d+)\.(\d+)(?:\(.*\))?", layout):
+        return int(figures.group(1)) + int(figures.group(2))
+    if counted := re.fullmatch(r"(\d+) channels(?: \(.*\))?", layout):
+        return int(counted.group(1))
+    return NAMED_LAYOUTS.get(layout.split("(")[0], 0)
 
 
 def _from_frames(path: Path, input_args: tuple, pix_fmt: str, details: str) -> tuple[str, Colour]:

@@ -16,7 +16,7 @@ WebM keep it as the video's tag, and other containers lose it, with a notice.
 from __future__ import annotations
 
 from stabilize.video.binary import local
-from stabilize.video.containers import Container
+from stabilize.video.containers import MAX_CHANNELS, Container
 from stabilize.video.encode import Mux
 from stabilize.video.probe import Stream, VideoInfo
 
@@ -51,7 +51,10 @@ def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0
             )
             continue
         if codec != "copy":
-            notices.append(f"{stream.kind} #{stream.index}: {stream.codec} → {codec} for {where}")
+            notices.append(
+                f"{stream.kind} #{stream.index}: {stream.codec} → {codec} for {where}"
+                + _downmix(stream, codec)
+            )
         args += ["-map", f"1:{stream.index}", f"-c:{flag}:{count[flag]}", codec]
         if flag == "a" and codec != "copy" and container.audio_rate:
             args += [f"-ar:a:{count[flag]}", str(container.audio_rate)]
@@ -74,13 +77,22 @@ def _codec(stream: Stream, container: Container) -> tuple[str | None, str]:
     """(``copy``, the encoder it becomes, or None: it cannot be held; FFmpeg's stream
     letter) of a source stream in ``container``."""
     if stream.kind == "audio":
-        return container.audio_codec(stream.codec), "a"
+        return container.audio_codec(stream.codec, stream.channels), "a"
     if stream.kind == "subtitle":
         return container.subtitle_codec(stream.codec), "s"
     if stream.kind == "attachment":
         return ("copy" if container.attachments else None), "t"
     held = stream.kind == "data" and stream.tag in container.data
     return ("copy" if held else None), "d"
+
+
+def _downmix(stream: Stream, codec: str) -> str:
+    """What the notice of a transcoded track adds where its encoder takes fewer channels
+    than it has: FFmpeg mixes it down (7.1 into AVI's AC-3: 5.1)."""
+    most = MAX_CHANNELS.get(codec)
+    if most is None or stream.channels <= most:
+        return ""
+    return f", its {stream.channels} channels mixed down to {most}"
 
 
 def _video_left_out(stream: Stream) -> str:

@@ -135,6 +135,28 @@ def test_avi_cannot_hold_subtitles_and_says_so(rich):
     assert sum("left out subtitle" in n for n in mux.notices) == 2
 
 
+@pytest.mark.parametrize("suffix", [".avi", ".mpg"])
+def test_surround_sound_stays_surround_in_avi_and_mpeg_ps(shaky, tmp_path, suffix):
+    # MP3 and MP2 take two channels: a 5.1 track was mixed down to stereo, unsaid
+    clip = tmp_path / "surround.mp4"
+    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-f", "lavfi", "-i"]
+    cmd += ["sine=d=2,aformat=channel_layouts=5.1|7.1", "-ac:a:0", "6", "-ac:a:1", "8"]
+    cmd += ["-map", "0:v", "-map", "1:a", "-map", "1:a", "-c:v", "copy", "-c:a", "aac"]
+    subprocess.run([*cmd, str(clip)], check=True)
+    info, out = probe(clip), tmp_path / f"out{suffix}"
+    assert [s.channels for s in info.streams] == [0, 6, 8]
+    mux = keep_streams(info, container_for(out))
+    assert mux.notices[0].startswith("audio #1: aac → ac3 for")
+    assert mux.notices[1].endswith(", its 8 channels mixed down to 6")
+    with FrameWriter(out, (64, 64), 25.0, Encoding(), mux) as writer:
+        for _ in range(3):
+            writer.write(np.zeros(writer.shape, writer.dtype))
+    with av.open(str(out)) as c:
+        assert [(a.codec_context.name, a.channels) for a in c.streams.audio] == [("ac3", 6)] * 2
+    stereo = keep_streams(probe(shaky), container_for(out))  # as it was: MP3, MP2
+    assert stereo.notices[0].split(" → ")[1].split()[0] in ("libmp3lame", "mp2")
+
+
 def test_a_second_video_stream_is_left_out_and_said_so(shaky, tmp_path):
     two = tmp_path / "two.mp4"
     cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-map", "0:v", "-map", "0:v"]
