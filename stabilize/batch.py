@@ -27,7 +27,12 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from stabilize.gyro.readers import GYRO_SIDECARS
+from stabilize.gyro.readers import (
+    GYRO_SIDECARS,
+    TELEMETRY_EXTRA,
+    carries_gyro,
+    telemetry_readable,
+)
 from stabilize.video import atomic_output
 from stabilize.video.atomic import sweep_stale
 
@@ -82,7 +87,7 @@ def find_jobs(
     """
     in_dir, out_dir = Path(in_dir).resolve(), Path(out_dir).resolve()
     tell = notify or (lambda _: None)
-    jobs, left_out = [], []
+    jobs, left_out, own_gyro, no_gyro = [], [], [], []
     for path in _files(in_dir, out_dir, pattern or "*", recursive):
         rel = path.relative_to(in_dir)
         if gyro_auto and path.suffix.lower() in GYRO_SIDECARS:
@@ -98,6 +103,9 @@ def find_jobs(
             ),
             None,
         )
+        if gyro_auto and sidecar is None:  # a camera's own (a GoPro's), else none
+            sidecar = path if carries_gyro(path) else None
+            (own_gyro if sidecar else no_gyro).append(rel.as_posix())
         stat = path.stat()
         jobs.append(
             Job(
@@ -110,12 +118,23 @@ def find_jobs(
             )
         )
     if left_out:
-        shown = ", ".join(left_out[:3]) + (", …" if len(left_out) > 3 else "")
         tell(
-            f"{len(left_out)} file(s) not named as videos left out ({shown}); "
+            f"{len(left_out)} file(s) not named as videos left out ({_few(left_out)}); "
             "--pattern '*' takes every file"
         )
+    if own_gyro:
+        tell(f"{len(own_gyro)} clip(s) stabilised from the gyro their camera recorded in "
+             f"them ({_few(own_gyro)})")  # fmt: skip
+    if no_gyro:
+        unread = "" if telemetry_readable() else f"; a camera's own is read with {TELEMETRY_EXTRA}"
+        tell(f"{len(no_gyro)} clip(s) with no gyro log beside them or in them, stabilised "
+             f"from their video ({_few(no_gyro)}){unread}")  # fmt: skip
     return _distinct_outputs(jobs, tell)
+
+
+def _few(names: list[str]) -> str:
+    """The first three of ``names``, and an ellipsis for the rest."""
+    return ", ".join(names[:3]) + (", …" if len(names) > 3 else "")
 
 
 def _files(in_dir: Path, out_dir: Path, pattern: str, recursive: bool) -> list[Path]:
@@ -181,6 +200,7 @@ def write_manifest(out_dir: Path, rows: dict[str, dict]) -> None:
         "zoom",
         "frames",
         "peak_mb",
+        "notices",
     ]
     with atomic_output(out_dir / "manifest.csv", overwrite=True) as tmp:
         # a name that is not UTF-8 (caf\xe9.mp4 off an old card) as its own bytes: it
@@ -188,7 +208,7 @@ def write_manifest(out_dir: Path, rows: dict[str, dict]) -> None:
         with open(tmp, "w", newline="", errors="surrogateescape") as f:
             writer = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
             writer.writeheader()
-            writer.writerows(ordered)
+            writer.writerows({**r, "notices": " | ".join(r.get("notices", ()))} for r in ordered)
 
 
 def is_complete(job: Job, row: dict | None, key: str = "") -> bool:
@@ -296,11 +316,13 @@ def run_job(job: Job, settings, on_frames: Callable[[int], None] | None = None) 
     start = time.perf_counter()
     row = job_row(job)
     row["settings"] = settings_key(settings)
+    notices: list[str] = []  # what the file's run would say (they were lost in a batch)
+    row["notices"] = notices
     try:
-        if job.gyro:
-            settings = replace(settings, gyro=job.gyro)
+        if job.gyro:  # a camera's own (in the clip) does not match a clip it steadied
+            settings = replace(settings, gyro=job.gyro, gyro_fallback=job.gyro == job.source)
         summary, _ = stabilize_video(
-            job.source, job.output, settings, overwrite=True, progress=stage
+            job.source, job.output, settings, overwrite=True, progress=stage, notify=notices.append
         )
         row.update(
             status="done",

@@ -386,9 +386,10 @@ def compiling_notice() -> tuple[str, ...]:
 def dates_rows(settings: Settings) -> bool:
     """Whether pass 1 also measures each band's rotations: to estimate the readout
     against the gyro, or to fit the visual attitude a rolling shutter is undone by."""
-    if settings.gyro:
-        return settings.readout_ms == "auto"
-    return settings.rolling_shutter not in ("off", 0, 0.0)
+    visual = settings.rolling_shutter not in ("off", 0, 0.0)
+    if settings.gyro:  # and, where the video may stand in for the log, as without one
+        return settings.readout_ms == "auto" or (settings.gyro_fallback and visual)
+    return visual
 
 
 def _motion(src: Path, job: Job, settings: Settings, bar, tell) -> tuple:
@@ -396,7 +397,7 @@ def _motion(src: Path, job: Job, settings: Settings, bar, tell) -> tuple:
     bands = READOUT_BANDS if dates_rows(settings) else 0
     # the flow vectors (about 5 KB a pair): the repair checks a jump against them, and
     # they are measured again once a rolling shutter's rows are dated
-    keep = job.log is None
+    keep = job.log is None or settings.gyro_fallback
     estimating = bar("estimating", max(len(job.times) - 1, 0))
     track, focal = estimate_motion(
         src,
@@ -425,20 +426,9 @@ def _rotations(
     (:func:`stabilize.warp.rolling.within_stretch`)."""
     reliable = np.ones(len(track.rotations), bool)
     shutter = None
-    if job.log is not None:
-        from stabilize.gyro.path import gyro_path  # gyro mode only
-        from stabilize.gyro.sync import MOTION_SCALE
-
-        R, rolling, summary = gyro_path(
-            settings, job.log, track, job.info.height, job.lens, job.stamps
-        )
-        scale = summary["motion_scale"]
-        if not MOTION_SCALE[0] <= scale <= MOTION_SCALE[1]:
-            tell(
-                f"gyro: the video turns {scale:.2f} times as far as its gyro: a clip "
-                "stabilised in the camera (the output may shake more than the input), or "
-                "a focal length far off (--fov, --lens)"
-            )
+    from_gyro = _gyro_rotations(settings, job, track, tell)
+    if from_gyro is not None:
+        R, rolling, summary = from_gyro
     else:
         samples = track.samples
         agreeing = refined = None
@@ -472,11 +462,44 @@ def _rotations(
         from stabilize.shutter.residual import rectified_residual
 
         residual = rectified_residual(track.samples, R, rolling, focal, job.info.height)
-    elif residual is not None and job.log is not None:  # measured after the visual rotations
+    elif residual is not None and from_gyro is not None:  # measured after the visual ones
         residual = reexpress(residual, track.rotations, R, focal, job.info.size)
     if residual is not None:
         residual = np.where(reliable[:, None], residual, 0.0)
     return R, rolling, residual, int((~reliable).sum()), summary, shutter, eased
+
+
+def _gyro_rotations(
+    settings: Settings, job: Job, track: VisualTrack, tell: Callable[[str], None]
+) -> tuple | None:
+    """(R_t, rolling-shutter turns or None, gyro summary) from the job's gyro log; None
+    without one, or where it does not match the video and ``settings.gyro_fallback``
+    lets the video's own motion be used instead (otherwise that is refused)."""
+    if job.log is None:
+        return None
+    from stabilize.gyro.log import GyroError  # gyro mode only
+    from stabilize.gyro.path import gyro_path
+    from stabilize.gyro.sync import MOTION_SCALE
+
+    try:
+        R, rolling, summary = gyro_path(
+            settings, job.log, track, job.info.height, job.lens, job.stamps
+        )
+    except GyroError as err:
+        if not settings.gyro_fallback:
+            raise
+        # its advice (--gyro-offset, --gyro-axes) is for one clip's log, not a camera's own
+        reason = str(err).removeprefix(f"{job.log.source}: ").split("; ")[0]
+        tell(f"gyro: not used, {reason}: stabilised from the video's own motion instead")
+        return None
+    scale = summary["motion_scale"]
+    if not MOTION_SCALE[0] <= scale <= MOTION_SCALE[1]:
+        tell(
+            f"gyro: the video turns {scale:.2f} times as far as its gyro: a clip "
+            "stabilised in the camera (the output may shake more than the input), or "
+            "a focal length far off (--fov, --lens)"
+        )
+    return R, rolling, summary
 
 
 def _write(

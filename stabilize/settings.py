@@ -69,6 +69,10 @@ class Settings:
     # the frame's middle (stabilize.path.optimal); 100: no limit
     max_stretch: float = DEFAULT_MAX_STRETCH
     gyro_drift: bool = False  # also fit a linear clock drift
+    # Where the log's motion does not match the video's, stabilise from the video's own
+    # instead of refusing: batch --gyro auto's, for the gyro a camera records in its
+    # clips, which one stabilised in the camera (a GoPro's HyperSmooth) does not match
+    gyro_fallback: bool = False
     gyro_timestamps: str | None = None  # frame times on the gyro clock (a file)
     gyro_search: float = 1.0  # offset search range, ± s (a log on its own clock: all of it)
     lens: str | None = None  # a Gyroflow lens profile (OpenCV fisheye)

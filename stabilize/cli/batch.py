@@ -65,7 +65,10 @@ def batch(
     ),
     recursive: bool = typer.Option(False, help="Descend into subfolders."),
     gyro: str | None = typer.Option(
-        None, help=f"'auto': use the gyro log beside each clip, of the same name ({SIDECARS})."
+        None,
+        help=f"'auto': use the gyro log beside each clip, of the same name ({SIDECARS}), "
+        "else the one its camera recorded in it (a GoPro's), unless that does not match its "
+        "video (a clip stabilised in the camera: then its video's motion, with a notice).",
     ),
     output_format: str | None = typer.Option(
         None,
@@ -137,6 +140,8 @@ def batch(
             file_done()
             if not quiet:
                 console.print(f"{row['status']:8s} {row['input']}  {row.get('error', '')}")
+                for said in row.get("notices", ()):
+                    console.print(f"         notice: {said}", markup=False, highlight=False)
 
         try:
             rows = run_batch(jobs, out_dir, settings, workers, done, ray, frames_done, force=force)

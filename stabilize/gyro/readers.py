@@ -15,6 +15,7 @@ in the sensor's own axes. :func:`read_gyro` detects the format from the file.
 from __future__ import annotations
 
 import csv
+import importlib.util
 import re
 from pathlib import Path
 
@@ -23,6 +24,9 @@ import numpy as np
 from stabilize.gyro.axes import axes_matrix
 from stabilize.gyro.log import GyroError, GyroLog
 
+TELEMETRY_EXTRA = (
+    "the 'telemetry' extra: pip install 'hough-stabilize[telemetry]' (the telemetry-parser package)"
+)
 GYRO_SIDECARS = (".gcsv", ".csv", ".txt")  # a log beside clip.mp4 (batch --gyro auto)
 VIDEO_SUFFIXES = {".mp4", ".mov", ".insv", ".360", ".mxf", ".mkv", ".braw", ".lrv", ".m4v"}
 NS_PER_FRAME_AT_LEAST = 1000.0  # a median frame step above this is in nanoseconds
@@ -272,13 +276,19 @@ def read_telemetry(path: str | Path) -> GyroLog:
     """Gyro embedded in a camera's file (GoPro GPMF, Sony, Insta360, DJI, Google CAMM, ...),
     through the optional ``telemetry-parser`` package; times on the video's timeline."""
     path = Path(path)
+    data = np.array(_telemetry_rows(path), dtype=np.float64)
+    _, keep = np.unique(data[:, 0], return_index=True)  # repeated stamps at block joins
+    data = data[np.sort(keep)]
+    return GyroLog(data[:, 0] * 1e-3, np.radians(data[:, 1:]), str(path))
+
+
+def _telemetry_rows(path: Path) -> list[tuple[float, ...]]:
+    """(ms, gx, gy, gz in °/s) of each gyro sample a camera wrote into its file, or a
+    GyroError saying why there are none."""
     try:
         import telemetry_parser
     except ImportError:
-        raise GyroError(
-            "reading camera-embedded telemetry needs the 'telemetry' extra: "
-            "pip install 'hough-stabilize[telemetry]' (the telemetry-parser package)"
-        ) from None
+        raise GyroError(f"{path}: reading a camera's own gyro needs {TELEMETRY_EXTRA}") from None
     if not path.is_file():
         raise GyroError(f"{path}: no such file")
     try:
@@ -288,10 +298,23 @@ def read_telemetry(path: str | Path) -> GyroLog:
     rows = [(s["timestamp_ms"], *s["gyro"]) for s in samples if s.get("gyro") is not None]
     if len(rows) < 2:
         raise GyroError(f"{path}: no gyro samples in the camera telemetry")
-    data = np.array(rows, dtype=np.float64)
-    _, keep = np.unique(data[:, 0], return_index=True)  # repeated stamps at block joins
-    data = data[np.sort(keep)]
-    return GyroLog(data[:, 0] * 1e-3, np.radians(data[:, 1:]), str(path))
+    return rows
+
+
+def telemetry_readable() -> bool:
+    """Whether a camera's own gyro can be read here: the telemetry extra is installed."""
+    return importlib.util.find_spec("telemetry_parser") is not None
+
+
+def carries_gyro(path: str | Path) -> bool:
+    """Whether a clip holds the gyro its camera recorded (a GoPro's GPMF track, ...), as
+    :func:`read_telemetry` reads it; False without the telemetry extra. About 20 ms on a
+    GoPro clip: the telemetry track alone is read."""
+    try:
+        _telemetry_rows(Path(path))
+    except GyroError:
+        return False
+    return True
 
 
 def detect_format(path: str | Path) -> str:

@@ -109,6 +109,30 @@ def test_gyro_sidecars_are_found_and_not_taken_for_clips(folder, tmp_path):
     assert jobs["a.mp4"].gyro.endswith("a.gcsv") and "a.gcsv" not in jobs
 
 
+def test_with_no_log_beside_it_a_cameras_own_gyro_is_taken(folder, tmp_path, shared):
+    # a GoPro's clips carry their gyro: --gyro auto stabilised them from their video alone
+    (folder / "gopro.mp4").write_bytes((shared / "data" / "gopro" / "karma.mp4").read_bytes())
+    said: list[str] = []
+    jobs = {
+        j.input: j for j in find_jobs(folder, tmp_path / "out", gyro_auto=True, notify=said.append)
+    }
+    assert jobs["gopro.mp4"].gyro == jobs["gopro.mp4"].source and jobs["a.mp4"].gyro is None
+    assert "1 clip(s) stabilised from the gyro their camera recorded in them (gopro.mp4)" in said
+    assert any("clip(s) with no gyro log beside them or in them" in n for n in said)
+
+
+def test_each_files_notices_are_kept_in_the_manifest(folder, tmp_path):
+    # a batch's files said nothing of what was changed or left out, where run says it
+    out = tmp_path / "out"
+    args = ["batch", str(folder), str(out), "--pattern", "a.mp4", "--format", "avi"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert "notice: audio #1: aac → libmp3lame for AVI" in result.output
+    row = json.loads((out / "manifest.json").read_text())[0]
+    assert "audio #1: aac → libmp3lame for AVI" in row["notices"]
+    assert "audio #1: aac → libmp3lame for AVI" in (out / "manifest.csv").read_text()
+
+
 def test_a_killed_run_leaves_nothing_unfinished_under_a_final_name(folder, tmp_path):
     out = tmp_path / "out"
     proc = subprocess.Popen(

@@ -5,6 +5,7 @@ import pytest
 from typer.testing import CliRunner
 
 from rotation import so3
+from stabilize import Settings, stabilize_video
 from stabilize.cli import app
 from stabilize.gyro import GyroError, GyroLog, read_gyro
 from stabilize.gyro.export import write_gcsv
@@ -90,22 +91,42 @@ def test_frame_times_on_the_gyro_clock_and_a_log_on_its_own(tmp_path):
     assert abs(gyro["offset_s"] - 123456.0 - meta["offset_s"]) < 2e-3
 
 
-def test_a_mismatched_gyro_is_refused(tmp_path):
+def noise_log(path):
+    """A 5 s gyro log of white noise (OpenCamera's layout), which no video's motion
+    matches."""
     rng = np.random.default_rng(1)
     t = np.arange(0, 5, 1 / 400)
-    path = tmp_path / "noise.csv"
     path.write_text(
         "".join(
             f"{x},{y},{z},{round(s * 1e9)}\n"
             for (x, y, z), s in zip(rng.normal(0, 0.3, (len(t), 3)), t, strict=True)
         )
     )
+    return path
+
+
+def test_a_mismatched_gyro_is_refused(tmp_path):
+    path = noise_log(tmp_path / "noise.csv")
     out = tmp_path / "o.mp4"
     result = CliRunner().invoke(
         app, ["run", str(SAMPLE / "clip.mp4"), str(out), "--gyro", str(path), "-q"]
     )
     assert result.exit_code != 0 and "does not match" in result.output
     assert not out.exists()
+
+
+def test_a_mismatched_gyro_may_give_way_to_the_video(tmp_path):
+    # batch --gyro auto's for a camera's own gyro, which a clip it steadied (a GoPro's
+    # HyperSmooth) does not match: that clip failed, where it was stabilised without
+    said: list[str] = []
+    log = str(noise_log(tmp_path / "noise.csv"))
+    settings = Settings(fov=70.0, gyro=log, gyro_fallback=True)
+    clip = SAMPLE / "clip.mp4"
+    summary, planned = stabilize_video(clip, tmp_path / "g.mp4", settings, notify=said.append)
+    _, visual = stabilize_video(clip, tmp_path / "v.mp4", Settings(fov=70.0))
+    assert summary["gyro"] is None and summary["frames"] == 90
+    assert any(n.startswith("gyro: not used, the gyro's motion does not match") for n in said)
+    assert np.allclose(planned.corrections(), visual.corrections())  # as without the log
 
 
 @pytest.mark.parametrize(
