@@ -34,31 +34,39 @@ def jello(tmp_path_factory) -> Path:
     return rendered(tmp_path_factory.mktemp("jello"), 25.0)
 
 
-def test_the_readout_is_found_and_the_wobble_undone(jello, tmp_path):
-    settings = Settings(fov=70.0, max_zoom=1.3, max_stretch=100.0)  # the whole correction
-    summary, planned = stabilize_video(jello, tmp_path / "auto.mp4", settings)
+WHOLE = Settings(fov=70.0, max_zoom=1.3, max_stretch=100.0)  # the whole correction
+OFF = Settings(fov=70.0, max_zoom=1.3, rolling_shutter="off")
+
+
+@pytest.fixture(scope="module")
+def runs(jello, tmp_path_factory) -> dict:
+    """(summary, path, output's metrics) of the jello clip stabilised with the whole
+    correction and without any, made once for the tests that compare with them."""
+    folder = tmp_path_factory.mktemp("runs")
+    out = {}
+    for name, settings in (("whole", WHOLE), ("off", OFF)):
+        summary, planned = stabilize_video(jello, folder / f"{name}.mp4", settings)
+        out[name] = (summary, planned, measured(jello, folder / f"{name}.mp4"))
+    return out
+
+
+def test_the_readout_is_found_and_the_wobble_undone(runs):
+    summary, planned, corrected = runs["whole"]
     found = summary["rolling_shutter"]
     assert found["source"] == "estimated" and found["readout_ms"] == pytest.approx(25.0, abs=2.5)
     assert planned.row_corrections is not None
-    off = Settings(fov=70.0, max_zoom=1.3, rolling_shutter="off")
-    summary_off, planned_off = stabilize_video(jello, tmp_path / "off.mp4", off)
+    summary_off, planned_off, uncorrected = runs["off"]
     assert summary_off["rolling_shutter"]["source"] == "off"
     assert planned_off.row_corrections is None
-    corrected, uncorrected = (
-        measured(jello, tmp_path / "auto.mp4").wobble_px,
-        measured(jello, tmp_path / "off.mp4").wobble_px,
-    )
-    assert corrected < 0.4 * uncorrected
+    assert corrected.wobble_px < 0.4 * uncorrected.wobble_px
 
 
 def test_a_phone_held_upright_has_its_readout_found_and_its_wobble_undone(jello, tmp_path):
     # stored level with a display rotation: its rows are the sensor's, as held level
     upright = held_upright(jello, tmp_path)
-    whole = Settings(fov=70.0, max_zoom=1.3, max_stretch=100.0)
-    summary, _ = stabilize_video(upright, tmp_path / "auto.mp4", whole)
+    summary, _ = stabilize_video(upright, tmp_path / "auto.mp4", WHOLE)
     assert summary["rolling_shutter"]["readout_ms"] == pytest.approx(25.0, abs=2.5)
-    off = Settings(fov=70.0, max_zoom=1.3, rolling_shutter="off")
-    stabilize_video(upright, tmp_path / "off.mp4", off)
+    stabilize_video(upright, tmp_path / "off.mp4", OFF)
     corrected, uncorrected = (
         measured(upright, tmp_path / "auto.mp4").wobble_px,
         measured(upright, tmp_path / "off.mp4").wobble_px,
@@ -66,18 +74,18 @@ def test_a_phone_held_upright_has_its_readout_found_and_its_wobble_undone(jello,
     assert corrected < 0.4 * uncorrected
 
 
-def test_the_correction_stretches_no_frame_past_the_budget(jello, tmp_path):
+def test_the_correction_stretches_no_frame_past_the_budget(jello, runs, tmp_path):
     # 3° of shake a frame under a 25 ms readout: undoing the rows' turns whole would
     # shear frames by several %, which the metric reads as distortion
-    whole = Settings(fov=70.0, max_zoom=1.3, max_stretch=100.0)
+    whole_summary, _, full = runs["whole"]
+    assert whole_summary["stretch_eased_frames"] == 0
     told: list[str] = []
-    assert stabilize_video(jello, tmp_path / "whole.mp4", whole)[0]["stretch_eased_frames"] == 0
     summary, _ = stabilize_video(
         jello, tmp_path / "eased.mp4", Settings(fov=70.0, max_zoom=1.3), notify=told.append
     )
     assert summary["stretch_eased_frames"] > 0
     assert any("eased" in line and "--max-stretch" in line for line in told)
-    eased, full = measured(jello, tmp_path / "eased.mp4"), measured(jello, tmp_path / "whole.mp4")
+    eased = measured(jello, tmp_path / "eased.mp4")
     assert full.distortion < 0.97
     assert eased.distortion > 0.985
 
