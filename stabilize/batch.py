@@ -30,7 +30,7 @@ from pathlib import Path
 from stabilize.gyro.readers import (
     GYRO_SIDECARS,
     TELEMETRY_EXTRA,
-    carries_gyro,
+    find_gyro_log,
     telemetry_readable,
 )
 from stabilize.video import atomic_output
@@ -95,16 +95,8 @@ def find_jobs(
         if pattern is None and path.suffix.lower() not in CLIP_SUFFIXES:
             left_out.append(rel.as_posix())
             continue
-        sidecar = next(
-            (
-                path.with_suffix(s)
-                for s in GYRO_SIDECARS
-                if gyro_auto and path.with_suffix(s).is_file()
-            ),
-            None,
-        )
-        if gyro_auto and sidecar is None:  # a camera's own (a GoPro's), else none
-            sidecar = path if carries_gyro(path) else None
+        sidecar = find_gyro_log(path) if gyro_auto else None
+        if gyro_auto and sidecar in (None, path):  # a camera's own (a GoPro's), or none
             (own_gyro if sidecar else no_gyro).append(rel.as_posix())
         stat = path.stat()
         jobs.append(

@@ -227,7 +227,7 @@ def job_settings(params: Mapping[str, Any]) -> Settings:
         deinterlace=params.get("deinterlace", DEFAULTS.deinterlace),
         bars=params.get("bars", DEFAULTS.bars),
         encoding=Encoding(codec=params["codec"], crf=params["crf"], preset=params["preset"]),
-        gyro=str(gyro) if gyro and gyro != "auto" else None,
+        gyro=str(gyro) if gyro and str(gyro) != "auto" else None,  # auto: the command's
         gyro_lpf=params["gyro_lpf"],
         readout_ms=readout(params["readout_ms"], gyro, shutter),
         rolling_shutter=shutter,

@@ -3,15 +3,17 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import typer
 
-from stabilize.cli.app import app, check_report_folder, notice, run_or_fail
+from stabilize.cli.app import app, check_report_folder, fail, notice, run_or_fail
 from stabilize.cli.options import (
     ENCODING,
     GYRO_SEARCH,
     NO_PREVIEW,
+    SIDECARS,
     BarsOption,
     CodecOption,
     CrfOption,
@@ -48,6 +50,22 @@ from stabilize.cli.options import (
     job_settings,
 )
 from stabilize.settings import DEFAULTS
+
+AUTO_GYRO = Path("auto")
+
+
+def gyro_beside_or_in(clip: Path) -> dict:
+    """The Settings fields of ``--gyro auto`` for ``clip``: the log beside it, else its
+    camera's own, which gives way to the video where it does not match it; or an error."""
+    from stabilize.gyro.readers import TELEMETRY_EXTRA, find_gyro_log, telemetry_readable
+
+    if not clip.is_file():
+        return {}  # said by the job: no such file, a folder, a pattern's pictures
+    found = find_gyro_log(clip)
+    if found is None:
+        unread = "" if telemetry_readable() else f"; a camera's own is read with {TELEMETRY_EXTRA}"
+        fail(f"--gyro auto: no gyro log beside {clip} ({SIDECARS}), nor in it{unread}")
+    return {"gyro": str(found), "gyro_fallback": found == clip}
 
 
 @app.command(
@@ -98,7 +116,11 @@ def run(
     bars: BarsOption = DEFAULTS.bars,
     fps: FpsOption = None,
     gyro: Path | None = typer.Option(
-        None, help="Stabilise from this gyro log (synchronised to the video) instead."
+        None,
+        help="Stabilise from this gyro log (synchronised to the video) instead; 'auto': "
+        f"the one beside the clip, of its name ({SIDECARS}), else the one its camera "
+        "recorded in it (a GoPro's), unless that does not match its video (a clip "
+        "stabilised in the camera: then its video's motion, with a notice).",
     ),
     gyro_format: GyroFormatOption = None,
     gyro_offset: GyroOffsetOption = None,
@@ -116,6 +138,8 @@ def run(
 ) -> None:
     """Stabilise a video: estimate each frame's rotation, smooth the path, warp, encode."""
     settings = job_settings(ctx.params)  # first: an option's mistake costs no import
+    if gyro == AUTO_GYRO:
+        settings = replace(settings, **gyro_beside_or_in(input_path))
     if report is not None:
         check_report_folder(report)
     from stabilize.cli.bars import with_bars

@@ -317,6 +317,16 @@ def carries_gyro(path: str | Path) -> bool:
     return True
 
 
+def find_gyro_log(clip: str | Path) -> Path | None:
+    """``--gyro auto``'s log for ``clip``: one beside it of the same name (the first of
+    :data:`GYRO_SIDECARS`), else the clip itself where its camera recorded its gyro in
+    it (:func:`carries_gyro`); None where there is neither."""
+    clip = Path(clip)
+    beside = (clip.with_suffix(suffix) for suffix in GYRO_SIDECARS)
+    found = next((path for path in beside if path.is_file()), None)
+    return found or (clip if carries_gyro(clip) else None)
+
+
 def detect_format(path: str | Path) -> str:
     """Guess the format from the suffix (camera files) or the first lines."""
     path = Path(path)

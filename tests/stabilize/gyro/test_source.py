@@ -46,16 +46,19 @@ def test_lowpass_removes_high_frequencies():
         lowpass(log, 500.0)
 
 
-def test_stabilising_from_the_gyro(tmp_path):
-    out = tmp_path / "gyro.mp4"
+def test_stabilising_from_the_gyro_beside_the_clip(tmp_path):
+    # --gyro auto, as batch's: the log of the clip's name (it was "auto: no such gyro log")
+    clip, out = tmp_path / "clip.mp4", tmp_path / "gyro.mp4"
+    clip.write_bytes((SAMPLE / "clip.mp4").read_bytes())
+    (tmp_path / "clip.csv").write_bytes((SAMPLE / "gyro.csv").read_bytes())
     result = CliRunner().invoke(
         app,
         [
             "run",
-            str(SAMPLE / "clip.mp4"),
+            str(clip),
             str(out),
             "--gyro",
-            str(SAMPLE / "gyro.csv"),
+            "auto",
             "--fov",
             "70",
             "--gyro-lpf",
@@ -69,6 +72,14 @@ def test_stabilising_from_the_gyro(tmp_path):
     assert abs(summary["gyro"]["offset_s"] - 0.35) < 1e-3
     assert abs(summary["gyro"]["motion_scale"] - 1) < 0.05
     assert summary["frames"] == 90 and out.is_file()
+
+
+def test_gyro_auto_with_no_log_beside_or_in_the_clip_is_refused(tmp_path):
+    out = tmp_path / "o.mp4"
+    args = ["run", str(SAMPLE / "clip.mp4"), str(out), "--gyro", "auto"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2 and "--gyro auto: no gyro log beside" in result.output
+    assert not out.exists()
 
 
 def test_frame_times_on_the_gyro_clock_and_a_log_on_its_own(tmp_path):
