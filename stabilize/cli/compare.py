@@ -14,6 +14,7 @@ from stabilize.cli.app import announce_compiling, app, run_or_fail
 from stabilize.cli.bars import with_bars
 from stabilize.cli.options import (
     GYRO_SEARCH,
+    SIDECARS,
     FlowOption,
     FocalOption,
     FovOption,
@@ -51,7 +52,11 @@ from stabilize.video.probe import VideoInfo
 def compare(
     ctx: typer.Context,
     video: str = typer.Argument(..., help="A video, or an image pattern like dir/img-%d.jpg."),
-    gyro: Path = typer.Option(..., help="The gyro log."),
+    gyro: Path = typer.Option(
+        ...,
+        help=f"The gyro log; 'auto': the one beside the clip, of its name ({SIDECARS}), else "
+        "the one its camera recorded in it (a GoPro's).",
+    ),
     gyro_format: GyroFormatOption = None,
     gyro_timestamps: GyroTimestampsOption = None,
     start_number: int | None = typer.Option(
@@ -126,6 +131,7 @@ def _comparison(params: dict, bar: ProgressFactory):
     from stabilize.evaluate.compare import compare_video
     from stabilize.gyro import read_gyro
     from stabilize.gyro.load import readout_seconds
+    from stabilize.gyro.readers import gyro_log_for
     from stabilize.gyro.sync import SyncOptions
     from stabilize.warp.lens import read_lens_profile
 
@@ -139,7 +145,10 @@ def _comparison(params: dict, bar: ProgressFactory):
         raise ValueError(LENS_WITH_FOCAL)
     R_cam_imu = axes_matrix(params["gyro_axes"])
     calibrate = params["calibrate_focal"]
-    log = read_gyro(params["gyro"], params["gyro_format"])
+    gyro, video = params["gyro"], params["video"]
+    if str(gyro) == "auto" and Path(video).is_file():  # a pattern's pictures carry none
+        gyro = gyro_log_for(video)
+    log = read_gyro(gyro, params["gyro_format"])
     info, times = _video_and_times(
         params["video"], params["start_number"], params["fps"], params["gyro_timestamps"]
     )

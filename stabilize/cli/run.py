@@ -8,7 +8,7 @@ from pathlib import Path
 
 import typer
 
-from stabilize.cli.app import app, check_report_folder, fail, notice, run_or_fail
+from stabilize.cli.app import app, check_report_folder, notice, run_or_fail
 from stabilize.cli.options import (
     ENCODING,
     GYRO_SEARCH,
@@ -57,14 +57,11 @@ AUTO_GYRO = Path("auto")
 def gyro_beside_or_in(clip: Path) -> dict:
     """The Settings fields of ``--gyro auto`` for ``clip``: the log beside it, else its
     camera's own, which gives way to the video where it does not match it; or an error."""
-    from stabilize.gyro.readers import TELEMETRY_EXTRA, find_gyro_log, telemetry_readable
+    from stabilize.gyro.readers import gyro_log_for
 
     if not clip.is_file():
         return {}  # said by the job: no such file, a folder, a pattern's pictures
-    found = find_gyro_log(clip)
-    if found is None:
-        unread = "" if telemetry_readable() else f"; a camera's own is read with {TELEMETRY_EXTRA}"
-        fail(f"--gyro auto: no gyro log beside {clip} ({SIDECARS}), nor in it{unread}")
+    found = run_or_fail(lambda: gyro_log_for(clip))
     return {"gyro": str(found), "gyro_fallback": found == clip}
 
 

@@ -327,6 +327,16 @@ def find_gyro_log(clip: str | Path) -> Path | None:
     return found or (clip if carries_gyro(clip) else None)
 
 
+def gyro_log_for(clip: str | Path) -> Path:
+    """:func:`find_gyro_log`'s log for ``clip``, or a GyroError where it has none."""
+    found = find_gyro_log(clip)
+    if found is None:
+        unread = "" if telemetry_readable() else f"; a camera's own is read with {TELEMETRY_EXTRA}"
+        sidecars = ", ".join(GYRO_SIDECARS)
+        raise GyroError(f"--gyro auto: no gyro log beside {clip} ({sidecars}), nor in it{unread}")
+    return found
+
+
 def detect_format(path: str | Path) -> str:
     """Guess the format from the suffix (camera files) or the first lines."""
     path = Path(path)

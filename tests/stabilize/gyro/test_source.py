@@ -76,9 +76,12 @@ def test_stabilising_from_the_gyro_beside_the_clip(tmp_path):
 
 def test_gyro_auto_with_no_log_beside_or_in_the_clip_is_refused(tmp_path):
     out = tmp_path / "o.mp4"
-    args = ["run", str(SAMPLE / "clip.mp4"), str(out), "--gyro", "auto"]
-    result = CliRunner().invoke(app, args)
-    assert result.exit_code == 2 and "--gyro auto: no gyro log beside" in result.output
+    for command in (
+        ["run", str(SAMPLE / "clip.mp4"), str(out)],
+        ["compare", str(SAMPLE / "clip.mp4")],
+    ):
+        result = CliRunner().invoke(app, [*command, "--gyro", "auto"])
+        assert result.exit_code == 2 and "--gyro auto: no gyro log beside" in result.output
     assert not out.exists()
 
 
