@@ -50,7 +50,7 @@ from stabilize.video.binary import local
 from stabilize.video.colour import DOLBY_BASE
 from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Encoding, Mux
-from stabilize.video.encoders import unused_quality
+from stabilize.video.encoders import unused_options
 from stabilize.video.fields import DEINTERLACE_MODES, field_times
 from stabilize.video.i420 import chroma, pipe_format
 from stabilize.video.preflight import (
@@ -233,7 +233,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
         if first is None:
             notices += ("an image sequence keeps no frame times (--report's path.csv has them)",)
     notices += encoder_notice(encoding, settings.encoding.codec_for(container))
-    notices += unused_quality(encoding.codec, encoding.crf)
+    notices += unused_options(encoding.codec, encoding.crf, encoding.preset)
     notices += shown_notice(times, container)
     notices += pipe_notices(info, piped_format(info, settings), encoding)
     if not settings.size and frame_size(info, settings) != info.shown_framed_size:

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from stabilize.video.binary import drain, ffmpeg_exe, local, widen_pipe
 from stabilize.video.colour import UNKNOWN, Colour
 from stabilize.video.containers import Container, container_for
-from stabilize.video.encoders import FRAME_CLOCKED, encoder_args
+from stabilize.video.encoders import DEFAULT_PRESET, FRAME_CLOCKED, encoder_args
 from stabilize.video.i420 import pipe_format, pipe_layout
 
 
@@ -34,7 +34,7 @@ class Encoding:
 
     codec: str | None = None
     crf: int | None = None
-    preset: str = "medium"
+    preset: str = DEFAULT_PRESET
     pix_fmt: str = "yuv420p"
     threads: int = 0  # encoder threads; 0 lets the encoder choose (all cores)
     b_frames: bool = True  # off for variable-frame-rate output, whose packets are retimed

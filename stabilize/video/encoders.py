@@ -18,6 +18,7 @@ X264_PRESETS = (
     "ultrafast", "superfast", "veryfast", "faster", "fast",
     "medium", "slow", "slower", "veryslow", "placebo",
 )  # fmt: skip
+DEFAULT_PRESET = "medium"
 # The quality a user gets from the default --crf 18 of x264, per encoder's own scale.
 DEFAULT_CRF = {"libx264": 18, "libx265": 20, "libvpx-vp9": 31, "libsvtav1": 30, "libaom-av1": 30}
 # The encoders whose frames lean on one another: no picture file holds one alone
@@ -117,13 +118,19 @@ def encoder_args(codec: str, crf: int | None, preset: str, deep: bool = False) -
     return ["-c:v", codec, *ENCODERS.get(codec, _x26x)(quality, preset)]
 
 
-def unused_quality(codec: str, crf: int | None) -> tuple[str, ...]:
-    """A notice where ``--crf`` was given for an encoder with no quality to set: PNG and
-    TIFF keep every sample, a GIF's palette is its quality (``--crf`` was ignored
-    silently)."""
+def unused_options(codec: str, crf: int | None, preset: str = DEFAULT_PRESET) -> tuple[str, ...]:
+    """Notices where ``--crf`` or ``--preset`` was given for an encoder with no use for
+    it: PNG and TIFF keep every sample, a GIF's palette is its quality, ProRes's and
+    DNxHR's profile is; JPEG, MPEG-2 and Theora have no speed to choose (each was ignored
+    silently). A preset left at its default is not said to be unused."""
     make = ENCODERS.get(codec, _x26x)
-    if crf is None or (codec not in PROFILES and make(0, "medium") != make(63, "medium")):
-        return ()
-    why = "it keeps every sample" if make is _lossless else "its palette is its quality"
-    why = "its profile is its quality" if codec in PROFILES else why
-    return (f"--crf {crf} has no effect on {codec}: {why}",)
+    said = []
+    if crf is not None and (codec in PROFILES or make(0, "medium") == make(63, "medium")):
+        why = "it keeps every sample" if make is _lossless else "its palette is its quality"
+        why = "its profile is its quality" if codec in PROFILES else why
+        said.append(f"--crf {crf} has no effect on {codec}: {why}")
+    quality = DEFAULT_CRF.get(codec, 18)
+    ignores = codec in PROFILES or make(quality, X264_PRESETS[0]) == make(quality, X264_PRESETS[-1])
+    if preset != DEFAULT_PRESET and ignores:
+        said.append(f"--preset {preset} has no effect on {codec}: it has no speed to choose")
+    return tuple(said)

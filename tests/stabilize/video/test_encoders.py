@@ -3,7 +3,7 @@
 import pytest
 
 from stabilize.video import Encoding
-from stabilize.video.encoders import encoder_args, unused_quality
+from stabilize.video.encoders import encoder_args, unused_options
 from stabilize.video.preflight import check_encoder
 
 
@@ -32,7 +32,25 @@ def test_each_encoder_takes_the_quality_on_its_own_scale():
     ],
 )
 def test_a_crf_with_no_effect_is_said(codec, crf, heard):
-    assert unused_quality(codec, crf) == ((heard,) if heard else ())
+    assert unused_options(codec, crf) == ((heard,) if heard else ())
+
+
+@pytest.mark.parametrize(
+    ("codec", "preset", "heard"),
+    [
+        ("prores_ks", "veryslow", "--preset veryslow has no effect on prores_ks"),
+        ("png", "fast", "--preset fast has no effect on png"),
+        ("mjpeg", "slow", "--preset slow has no effect on mjpeg"),
+        ("libtheora", "slow", "--preset slow has no effect on libtheora"),
+        ("prores_ks", "medium", None),  # the default: not given
+        ("libx264", "veryslow", None),
+        ("libvpx-vp9", "veryslow", None),  # its -cpu-used
+        ("some-new-encoder", "slow", None),  # gets -preset as it is
+    ],
+)
+def test_a_preset_with_no_effect_is_said(codec, preset, heard):
+    said = unused_options(codec, None, preset)
+    assert said == () if heard is None else said[0].startswith(heard)
 
 
 @pytest.mark.parametrize("codec", ["dnxhd", "prores_ks", "prores_aw"])
