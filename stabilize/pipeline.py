@@ -64,6 +64,7 @@ from stabilize.video.sequence import (
     first_image,
     is_pattern,
     picture,
+    rate_notice,
     sequence_args,
     sequence_files,
 )
@@ -226,7 +227,8 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
         info = info.within_bars(detect_bars(info))
     mux = keep_streams(info, container, info.video_delay)
     check_streams(dst, encoding, encoded_size(info, settings), mux, info.fps or 30.0)
-    notices = mux.notices + fields_notice(info) + pixels_notice(info) + bars_notice(info)
+    notices = rate_notice(src, settings.fps) + mux.notices + fields_notice(info)
+    notices += pixels_notice(info) + bars_notice(info)
     if not container.timed:  # an image sequence: numbered as the input's, else from 1
         first = first_image(info.input_args)
         mux = replace(mux, args=(*mux.args, "-start_number", str(1 if first is None else first)))

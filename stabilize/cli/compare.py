@@ -10,7 +10,7 @@ import numpy as np
 import typer
 from numpy.typing import NDArray
 
-from stabilize.cli.app import announce_compiling, app, run_or_fail
+from stabilize.cli.app import announce_compiling, app, notice, run_or_fail
 from stabilize.cli.bars import with_bars
 from stabilize.cli.options import (
     GYRO_SEARCH,
@@ -184,9 +184,12 @@ def _video_and_times(
     """The video (or image sequence) and its frame times: the container's, or those of a
     ``timestamps`` file on the sensor's clock (line N is image N of a sequence)."""
     from stabilize.video import frame_times, probe, sequence_args
+    from stabilize.video.sequence import rate_notice
 
     args = sequence_args(video, start_number, fps)
     info = probe(video, args).stored()  # the sensor's rows and axes, however it was held
+    for said in rate_notice(video, fps) if timestamps is None else ():  # the sync's clock
+        notice(said)
     times = frame_times(video, args)
     if timestamps is not None:
         from stabilize.gyro.readers import first_stamp, sensor_frame_times

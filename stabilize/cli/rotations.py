@@ -68,6 +68,7 @@ def rotations(
     from stabilize.video import atomic_output, probe, sequence_args
     from stabilize.video.atomic import check_absent, check_not_input
     from stabilize.video.preflight import check_writable
+    from stabilize.video.sequence import rate_notice
     from stabilize.warp.lens import read_lens_profile
 
     if output is None and gcsv is None:
@@ -86,6 +87,8 @@ def rotations(
         fail(LENS_WITH_FOCAL)
     # the sensor's axes, as compare's
     info = run_or_fail(lambda: probe(input_path, sequence_args(input_path, fps=fps)).stored())
+    for said in rate_notice(input_path, fps):  # the CSV's and the .gcsv's times
+        notice(said)
     # the flow is read through the lens: a fisheye's rotations taken as a pinhole's were
     # 0.015° a pair further from the truth (tests/stabilize/warp/test_lens.py)
     camera = run_or_fail(lambda: read_lens_profile(lens, info.size)) if lens else None

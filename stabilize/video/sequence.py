@@ -164,6 +164,15 @@ def sequence_args(
     return ("-f", "image2", *first, "-framerate", str(fps or SEQUENCE_FPS))
 
 
+def rate_notice(path: str | Path, fps: float | None) -> tuple[str, ...]:
+    """A notice where an image sequence is read at :data:`SEQUENCE_FPS` for want of
+    ``fps``: its pictures hold no rate, and a 60 fps burst came out at half its speed,
+    unsaid."""
+    if not is_pattern(path) or fps is not None:
+        return ()
+    return (f"an image sequence holds no frame rate: read at {SEQUENCE_FPS:g} fps (--fps sets it)",)
+
+
 def first_image(input_args: tuple) -> int | None:
     """The first image's number in an image sequence's input options; None for a video
     (or a pattern that names no file)."""

@@ -14,6 +14,7 @@ import pytest
 from rotation import so3
 from stabilize import Settings, stabilize_video
 from stabilize.motion.focal import initial_focal
+from stabilize.pipeline import prepare
 from stabilize.synth import SynthOptions, trajectory
 from stabilize.video import Encoding, ffmpeg_exe, frame_times, probe, read_frames
 from tests.stabilize.conftest import render
@@ -204,6 +205,10 @@ def test_an_image_sequence_is_read_from_its_lowest_number_at_the_rate_given(shak
     summary, _ = stabilize_video(pattern, out, Settings(fov=70.0, fps=24.0))
     assert summary["frames"] == 20 and probe(out).fps == 24.0
     assert np.allclose(np.diff(frame_times(out)), 1 / 24, atol=1e-3)
+    # without --fps it is read at 30 fps, which is said (a 60 fps burst played at half speed)
+    assert not any("holds no frame rate" in n for n in summary["notices"])
+    unsaid = prepare(pattern, tmp_path / "o30.mp4", Settings(fov=70.0), False).notices
+    assert "an image sequence holds no frame rate: read at 30 fps (--fps sets it)" in unsaid
 
 
 def test_a_colon_in_a_relative_name_is_not_taken_for_a_protocol(shaky, tmp_path, monkeypatch):
