@@ -27,12 +27,7 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from stabilize.gyro.readers import (
-    GYRO_SIDECARS,
-    TELEMETRY_EXTRA,
-    find_gyro_log,
-    telemetry_readable,
-)
+from stabilize.gyro.readers import GYRO_SIDECARS, find_gyro_log, unread_telemetry
 from stabilize.video import atomic_output
 from stabilize.video.atomic import sweep_stale
 
@@ -118,9 +113,8 @@ def find_jobs(
         tell(f"{len(own_gyro)} clip(s) stabilised from the gyro their camera recorded in "
              f"them ({_few(own_gyro)})")  # fmt: skip
     if no_gyro:
-        unread = "" if telemetry_readable() else f"; a camera's own is read with {TELEMETRY_EXTRA}"
         tell(f"{len(no_gyro)} clip(s) with no gyro log beside them or in them, stabilised "
-             f"from their video ({_few(no_gyro)}){unread}")  # fmt: skip
+             f"from their video ({_few(no_gyro)}){unread_telemetry()}")  # fmt: skip
     return _distinct_outputs(jobs, tell)
 
 
@@ -311,7 +305,7 @@ def run_job(job: Job, settings, on_frames: Callable[[int], None] | None = None) 
     notices: list[str] = []  # what the file's run would say (they were lost in a batch)
     row["notices"] = notices
     try:
-        if job.gyro:  # a camera's own (in the clip) does not match a clip it steadied
+        if job.gyro:  # a camera's own gyro (the clip itself) gives way where it steadied it
             settings = replace(settings, gyro=job.gyro, gyro_fallback=job.gyro == job.source)
         summary, _ = stabilize_video(
             job.source, job.output, settings, overwrite=True, progress=stage, notify=notices.append

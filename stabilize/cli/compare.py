@@ -131,8 +131,9 @@ def _comparison(params: dict, bar: ProgressFactory):
     from stabilize.evaluate.compare import compare_video
     from stabilize.gyro import read_gyro
     from stabilize.gyro.load import readout_seconds
-    from stabilize.gyro.readers import gyro_log_for
+    from stabilize.gyro.readers import AUTO_FOR_SEQUENCE, gyro_log_for
     from stabilize.gyro.sync import SyncOptions
+    from stabilize.video.sequence import is_pattern
     from stabilize.warp.lens import read_lens_profile
 
     flow_name, weights, fov, focal = (
@@ -146,12 +147,14 @@ def _comparison(params: dict, bar: ProgressFactory):
     R_cam_imu = axes_matrix(params["gyro_axes"])
     calibrate = params["calibrate_focal"]
     gyro, video = params["gyro"], params["video"]
-    if str(gyro) == "auto" and Path(video).is_file():  # a pattern's pictures carry none
-        gyro = gyro_log_for(video)
-    log = read_gyro(gyro, params["gyro_format"])
+    if str(gyro) == "auto" and is_pattern(video):
+        raise ValueError(AUTO_FOR_SEQUENCE)
+    auto = str(gyro) == "auto"  # found beside the video, once it is known to be one
+    log = None if auto else read_gyro(gyro, params["gyro_format"])
     info, times = _video_and_times(
-        params["video"], params["start_number"], params["fps"], params["gyro_timestamps"]
+        video, params["start_number"], params["fps"], params["gyro_timestamps"]
     )
+    log = log or read_gyro(gyro_log_for(video), params["gyro_format"])
     camera = read_lens_profile(params["lens"], info.size) if params["lens"] else None
     if camera is not None and calibrate:
         raise ValueError("--calibrate-focal fits a pinhole focal length; --lens brings its own")
