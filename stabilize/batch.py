@@ -27,7 +27,8 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from stabilize.gyro.readers import GYRO_SIDECARS, find_gyro_log, unread_telemetry
+from stabilize.gyro.load import find_gyro_log, gyro_settings
+from stabilize.gyro.readers import GYRO_SIDECARS, unread_telemetry
 from stabilize.video import atomic_output
 from stabilize.video.atomic import sweep_stale
 
@@ -305,8 +306,8 @@ def run_job(job: Job, settings, on_frames: Callable[[int], None] | None = None) 
     notices: list[str] = []  # what the file's run would say (they were lost in a batch)
     row["notices"] = notices
     try:
-        if job.gyro:  # a camera's own gyro (the clip itself) gives way where it steadied it
-            settings = replace(settings, gyro=job.gyro, gyro_fallback=job.gyro == job.source)
+        if job.gyro:
+            settings = replace(settings, **gyro_settings(Path(job.gyro), Path(job.source)))
         summary, _ = stabilize_video(
             job.source, job.output, settings, overwrite=True, progress=stage, notify=notices.append
         )

@@ -130,8 +130,7 @@ def _comparison(params: dict, bar: ProgressFactory):
     """The comparison the parsed options ``params`` ask for."""
     from stabilize.evaluate.compare import compare_video
     from stabilize.gyro import read_gyro
-    from stabilize.gyro.load import readout_seconds
-    from stabilize.gyro.readers import AUTO_FOR_SEQUENCE, gyro_log_for
+    from stabilize.gyro.load import AUTO_FOR_SEQUENCE, gyro_log_for, readout_seconds
     from stabilize.gyro.sync import SyncOptions
     from stabilize.video.sequence import is_pattern
     from stabilize.warp.lens import read_lens_profile

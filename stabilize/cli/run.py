@@ -57,15 +57,14 @@ AUTO_GYRO = Path("auto")
 def gyro_beside_or_in(clip: Path) -> dict:
     """The Settings fields of ``--gyro auto`` for ``clip``: the log beside it, else its
     camera's own, which gives way to the video where it does not match it; or an error."""
-    from stabilize.gyro.readers import AUTO_FOR_SEQUENCE, gyro_log_for
+    from stabilize.gyro.load import AUTO_FOR_SEQUENCE, gyro_log_for, gyro_settings
     from stabilize.video.sequence import is_pattern
 
     if is_pattern(clip):
         fail(AUTO_FOR_SEQUENCE)
     if not clip.is_file():
         return {}  # said by the job: no such file, a folder
-    found = run_or_fail(lambda: gyro_log_for(clip))
-    return {"gyro": str(found), "gyro_fallback": found == clip}
+    return gyro_settings(run_or_fail(lambda: gyro_log_for(clip)), clip)
 
 
 @app.command(

@@ -1,13 +1,18 @@
 """Reading the gyro log a job names, and checking it, before any work: reading it costs
-no numba kernel, so a bad log is reported in a fraction of a second."""
+no numba kernel, so a bad log is reported in a fraction of a second. ``--gyro auto``
+finds the log: beside the clip, else in it."""
 
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 from stabilize.gyro.log import GyroError, GyroLog
-from stabilize.gyro.readers import read_gyro
+from stabilize.gyro.readers import GYRO_SIDECARS, carries_gyro, read_gyro, unread_telemetry
 from stabilize.settings import Settings
+
+# --gyro auto looks beside a clip for a log of its name: an image sequence has none
+AUTO_FOR_SEQUENCE = "--gyro auto finds a clip's own log; an image sequence's is given: --gyro LOG"
 
 
 def load_gyro(settings: Settings) -> GyroLog:
@@ -39,3 +44,33 @@ def readout_seconds(option: float | str | None, from_log: float | None) -> float
     if not 0.0 <= value < 1000.0:
         raise ValueError(f"--readout-ms must be between 0 and 1000 ms, got {option}")
     return value / 1000.0
+
+
+def find_gyro_log(clip: str | Path) -> Path | None:
+    """``--gyro auto``'s log for ``clip``: one beside it of the same name (the first of
+    :data:`GYRO_SIDECARS`), else the clip itself where its camera recorded its gyro in
+    it (:func:`carries_gyro`); None where there is neither."""
+    clip = Path(clip)
+    beside = (clip.with_suffix(suffix) for suffix in GYRO_SIDECARS)
+    found = next((path for path in beside if path.is_file()), None)
+    return found or (clip if carries_gyro(clip) else None)
+
+
+def gyro_log_for(clip: str | Path) -> Path:
+    """:func:`find_gyro_log`'s log for ``clip``, or a GyroError where it has none."""
+    found = find_gyro_log(clip)
+    if found is None:
+        sidecars = ", ".join(GYRO_SIDECARS)
+        raise GyroError(
+            f"--gyro auto: no gyro log beside {clip} ({sidecars}), nor in it{unread_telemetry()}"
+        )
+    return found
+
+
+def gyro_settings(log: Path, clip: Path) -> dict:
+    """The Settings fields of ``--gyro auto``'s ``log`` for ``clip``: a camera's own
+    gyro (the clip itself) is read as its telemetry, whatever ``--gyro-format`` names
+    for the logs beside clips, and gives way to the video's motion where it does not
+    match it (a clip the camera steadied: a GoPro's HyperSmooth)."""
+    own = log == clip
+    return {"gyro": str(log), "gyro_fallback": own} | ({"gyro_format": "telemetry"} if own else {})

@@ -27,8 +27,6 @@ from stabilize.gyro.log import GyroError, GyroLog
 TELEMETRY_EXTRA = (
     "the 'telemetry' extra: pip install 'hough-stabilize[telemetry]' (the telemetry-parser package)"
 )
-# --gyro auto looks beside a clip for a log of its name: an image sequence has none
-AUTO_FOR_SEQUENCE = "--gyro auto finds a clip's own log; an image sequence's is given: --gyro LOG"
 GYRO_SIDECARS = (".gcsv", ".csv", ".txt")  # a log beside clip.mp4 (batch --gyro auto)
 VIDEO_SUFFIXES = {".mp4", ".mov", ".insv", ".360", ".mxf", ".mkv", ".braw", ".lrv", ".m4v"}
 NS_PER_FRAME_AT_LEAST = 1000.0  # a median frame step above this is in nanoseconds
@@ -320,27 +318,6 @@ def carries_gyro(path: str | Path) -> bool:
     except GyroError:
         return False
     return True
-
-
-def find_gyro_log(clip: str | Path) -> Path | None:
-    """``--gyro auto``'s log for ``clip``: one beside it of the same name (the first of
-    :data:`GYRO_SIDECARS`), else the clip itself where its camera recorded its gyro in
-    it (:func:`carries_gyro`); None where there is neither."""
-    clip = Path(clip)
-    beside = (clip.with_suffix(suffix) for suffix in GYRO_SIDECARS)
-    found = next((path for path in beside if path.is_file()), None)
-    return found or (clip if carries_gyro(clip) else None)
-
-
-def gyro_log_for(clip: str | Path) -> Path:
-    """:func:`find_gyro_log`'s log for ``clip``, or a GyroError where it has none."""
-    found = find_gyro_log(clip)
-    if found is None:
-        sidecars = ", ".join(GYRO_SIDECARS)
-        raise GyroError(
-            f"--gyro auto: no gyro log beside {clip} ({sidecars}), nor in it{unread_telemetry()}"
-        )
-    return found
 
 
 def detect_format(path: str | Path) -> str:
