@@ -133,14 +133,15 @@ def skyline(rng: np.random.Generator, width: int = 4096) -> NDArray[np.uint8]:
     return np.clip(sky, 0, 255).astype(np.uint8)
 
 
-def load_background(path: Path | None, rng: np.random.Generator) -> Background:
-    """The cube-map photograph at ``path`` if given, else the procedural skyline."""
+def load_background(path: Path | None, rng: np.random.Generator, width: int = 4096) -> Background:
+    """The cube-map photograph at ``path`` if given, else the procedural skyline
+    ``width`` pixels around."""
     if path is not None:
         img = cv2.imread(str(path), cv2.IMREAD_COLOR)
         if img is None or img.shape[0] != 6 * img.shape[1]:
             raise ValueError(f"{path} is not a cube map of six square faces stacked vertically")
         return Background(img[..., ::-1].copy(), "cube")
-    return Background(skyline(rng), "panorama")
+    return Background(skyline(rng, width), "panorama")
 
 
 def mip_chain(texture: NDArray[np.uint8], levels: int = 4) -> list[NDArray[np.uint8]]:
