@@ -63,6 +63,7 @@ def test_a_zoomed_crop_ranks_below_an_uncropped_one(shaken):
 
 def test_several_outputs_read_against_one_original_as_each_alone(shaken):
     # the benches read two tools' outputs in one pass over the original
+    shaken = shaken[:40]  # a second and a third: the 0.5 s high-pass twice over
     steadier = [shaken[0]] * len(shaken)
     zoomed = [f[8:-8, 16:-16] for f in shaken]
     zoomed = [cv2.resize(f, (shaken[0].shape[1], shaken[0].shape[0])) for f in zoomed]
