@@ -120,3 +120,10 @@ def test_sigterm_leaves_no_temporary_file(tmp_path):
     _, err = job.communicate(timeout=60)
     assert job.returncode == 143 and "error: terminated (SIGTERM)" in err
     assert list(out.parent.iterdir()) == []
+
+
+def test_the_package_runs_as_the_command():
+    # python -m stabilize: "'stabilize' is a package and cannot be directly executed"
+    for module in ("stabilize", "stabilize.cli"):
+        done = subprocess.run([sys.executable, "-m", module, "--version"], capture_output=True)
+        assert done.returncode == 0 and done.stdout.decode().startswith("stabilize ")
