@@ -12,6 +12,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 RANK = {
+    "__main__": 10,  # python -m stabilize: the command line, and nothing else
     "cli": 9,
     "batch": 8,
     "pipeline": 7,
