@@ -576,7 +576,12 @@ def settings_summary(settings: Settings) -> dict:
 
 def _check_output(src: Path, dst: Path, overwrite: bool) -> None:
     """Refuse an output that is the input, that would replace any of the input's
-    pictures, or that exists without ``overwrite``."""
+    pictures, that is standard output, or that exists without ``overwrite``."""
+    if str(dst) == "-":  # it read "no suffix names its container ... (-.mp4)"
+        raise ValueError(
+            "OUT '-': a video is written to a file, named once it is whole, not to standard "
+            "output: name one, e.g. steady.mp4"
+        )
     if src.resolve() == dst.resolve():  # (an image sequence's pattern names no one file)
         raise ValueError(f"the output {dst} is the input; choose another name")
     check_not_input(dst, src)  # by another name: a link, another spelling

@@ -67,6 +67,14 @@ def test_output_equal_to_the_input_is_refused(tmp_path):
     assert (tmp_path / "copy.mp4").read_bytes() == clip.read_bytes()
 
 
+def test_standard_output_is_refused_as_the_output_by_name(shaky, tmp_path, monkeypatch):
+    # it read "-: no suffix names its container ... (-.mp4)"
+    monkeypatch.chdir(tmp_path)
+    result = RUNNER.invoke(app, ["run", str(shaky), "-"])
+    assert result.exit_code == 2 and "OUT '-': a video is written to a file" in result.output
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_one_and_zero_frame_videos(shaky, tmp_path):
     one, silent = tmp_path / "one.mp4", tmp_path / "audio_only.m4a"
     ff = [ffmpeg_exe(), "-hide_banner", "-loglevel", "error", "-y"]
