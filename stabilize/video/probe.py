@@ -287,6 +287,10 @@ def probe(path: str | Path, input_args: tuple = ()) -> VideoInfo:
     pattern = is_pattern(path)
     input_args = input_args or sequence_args(path)  # a sequence's first number, at 30 fps
     path = Path(path)
+    if str(path) == "-" and not path.exists():  # it read "-: no such file"
+        raise VideoError(
+            "IN '-': a clip is read in two passes, not from standard input: save it first"
+        )
     if not pattern and not path.exists() and (url := _URL.match(str(path))):
         # FFmpeg would stream it, but a clip is read three times (probe, two passes):
         # downloaded three times, and a live stream's passes would see different frames

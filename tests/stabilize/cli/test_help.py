@@ -76,6 +76,14 @@ def test_a_pipe_for_the_clip_is_refused_before_it_waits(tmp_path, monkeypatch, c
     )
 
 
+def test_standard_input_for_the_clip_is_named_as_such(monkeypatch, capsys, tmp_path):
+    monkeypatch.chdir(tmp_path)  # it read "-: no such file"
+    monkeypatch.setattr("sys.argv", ["stabilize", "-", "out.mp4"])
+    with pytest.raises(SystemExit) as done:
+        main()
+    assert done.value.code == 2 and "not from standard input" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("url", ["https://example.com/clip.mp4", "rtmp://example.com/live"])
 def test_a_url_for_the_clip_is_named_as_one(monkeypatch, capsys, url):
     # the path's "//" became "/" and the URL was said to be a missing file
