@@ -158,7 +158,8 @@ def run(
         typer.echo(json.dumps(summary, indent=2))
     elif not quiet:
         typer.echo(
+            # the work's speed, in words a clip's frame rate is not read for ("46.9 fps")
             f"{output_path}: {summary['frames']} frames, zoom {summary['zoom']:.3f}, "
-            f"{summary['fps']:.1f} fps",
+            f"in {summary['seconds']['total']:.1f} s ({summary['fps']:.1f} frames a second)",
             err=True,
         )
