@@ -116,7 +116,7 @@ def batch(
     from rich.console import Console
 
     import flow
-    from stabilize.batch import run_batch
+    from stabilize.batch import BYTES_PER_WORKER, default_workers, run_batch
     from stabilize.cli.bars import batch_progress
     from stabilize.pipeline import check_settings
     from stabilize.warp.lens import read_lens_profile
@@ -132,6 +132,12 @@ def batch(
         run_or_fail(lambda: read_lens_profile(lens))
     run_or_fail(lambda: flow.check_weights(flow_name, raft_weights))
     jobs = _jobs(ctx.params, settings)
+    if workers and not ray and min(workers, len(jobs)) > default_workers():
+        notice(
+            f"--workers {workers}: this machine runs {default_workers()} at once (a core each, "
+            f"and {BYTES_PER_WORKER / 2**30:.1f} GB of memory for a 1080p clip); more take as "
+            "long or longer, and may be killed for memory"
+        )
     announce_compiling()
     console = Console(stderr=True)
     with batch_progress(len(jobs), quiet=quiet) as (file_done, frames_done):

@@ -41,6 +41,20 @@ def test_options_that_would_fail_every_clip_are_refused_before_any(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+def test_more_workers_than_the_machine_runs_at_once_is_said(tmp_path, monkeypatch):
+    # a pool of 8 on 2 cores took as long, or was killed for memory, unsaid
+    (tmp_path / "in").mkdir()
+    for name in "abc":
+        (tmp_path / "in" / f"{name}.mp4").write_bytes(SAMPLE.read_bytes())
+    monkeypatch.setattr("stabilize.batch.default_workers", lambda: 2)
+    monkeypatch.setattr("stabilize.batch.run_batch", lambda *args, **kwargs: [])
+    for workers, said in (("8", True), ("2", False)):
+        args = ["batch", str(tmp_path / "in"), str(tmp_path / "out"), "--workers", workers]
+        result = CliRunner().invoke(app, args)
+        assert result.exit_code == 0, result.output
+        assert ("notice: --workers 8: this machine runs 2 at once" in result.output) is said
+
+
 def test_batch_takes_every_option_of_the_single_file_command():
     commands = typer.main.get_command(app).commands
     names = {name: {p.name for p in commands[name].params} for name in ("run", "batch")}
