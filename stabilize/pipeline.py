@@ -495,6 +495,14 @@ def _gyro_rotations(
         tell(f"gyro: not used, {reason}: stabilised from the video's own motion instead")
         return None
     scale = summary["motion_scale"]
+    if not MOTION_SCALE[0] <= scale <= MOTION_SCALE[1] and settings.gyro_fallback:
+        # max-heromode's own gyro turns 6 times as far as its video, which the camera
+        # steadied: stabilised from it, the clip would shake more than it does
+        tell(
+            f"gyro: not used, the video turns {scale:.2f} times as far as its gyro (a clip "
+            "stabilised in the camera): stabilised from the video's own motion instead"
+        )
+        return None
     if not MOTION_SCALE[0] <= scale <= MOTION_SCALE[1]:
         tell(
             f"gyro: the video turns {scale:.2f} times as far as its gyro: a clip "

@@ -1,4 +1,5 @@
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -14,10 +15,10 @@ from stabilize.gyro.sync import visual_rates
 from tests.stabilize.helpers import SAMPLE, held_upright
 
 
-def sample_log(path, gain: float = 1.0, shift_ns: int = 0):
-    """The sample's gyro log (x, y, z rad/s, t ns) written to ``path`` with its rates
-    times ``gain`` and its clock ``shift_ns`` later."""
-    rows = (line.split(",") for line in (SAMPLE / "gyro.csv").read_text().splitlines())
+def sample_log(path, gain: float = 1.0, shift_ns: int = 0, source=SAMPLE / "gyro.csv"):
+    """The sample's gyro log (x, y, z rad/s, t ns), or ``source``'s, written to ``path``
+    with its rates times ``gain`` and its clock ``shift_ns`` later."""
+    rows = (line.split(",") for line in source.read_text().splitlines())
     path.write_text(
         "".join(
             f"{gain * float(x)},{gain * float(y)},{gain * float(z)},{int(t) + shift_ns}\n"
@@ -139,6 +140,13 @@ def test_a_mismatched_gyro_may_give_way_to_the_video(shaky, tmp_path):
     assert summary["gyro"] is None and summary["frames"] == 60
     assert any(n.startswith("gyro: not used, the gyro's motion does not match") for n in said)
     assert np.allclose(planned.corrections(), visual.corrections())  # as without the log
+    # one that turns 3 times as far as the video (max-heromode's: 6 times) gives way too
+    thrice = sample_log(tmp_path / "thrice.csv", 3.0, source=shaky.parent / "gyro.csv")
+    settings = replace(settings, gyro=str(thrice))
+    summary, planned = stabilize_video(shaky, tmp_path / "t.mp4", settings, notify=said.append)
+    assert summary["gyro"] is None
+    assert any(n.startswith("gyro: not used, the video turns 0.3") for n in said)
+    assert np.allclose(planned.corrections(), visual.corrections())
 
 
 @pytest.mark.parametrize(
