@@ -119,9 +119,15 @@ def stabilize_video(
     src, dst = Path(input_path), Path(output_path)
     Thread(target=warm_up, name="warm-up", daemon=True).start()  # while FFmpeg probes
     job = prepare(src, dst, settings, overwrite)
-    tell = notify or (lambda _: None)
+    said = list(job.notices)  # and what the work finds: the summary's (and --json's) too
+    heard = notify or (lambda _: None)
+
+    def tell(message: str) -> None:
+        said.append(message)
+        heard(message)
+
     for notice in (*job.notices, *compiling_notice()):
-        tell(notice)
+        heard(notice)
     start = time.perf_counter()
     bar = progress or (lambda label, total: no_progress)
     try:
@@ -185,7 +191,7 @@ def stabilize_video(
         "gyro": gyro_summary,
         "rolling_shutter": None if shutter is None else shutter.summary(),
         "stretch_eased_frames": eased,  # rolling-shutter corrections kept within --max-stretch
-        "notices": list(job.notices),
+        "notices": said,
     }
     return summary, planned
 

@@ -139,6 +139,9 @@ def test_a_mismatched_gyro_may_give_way_to_the_video(shaky, tmp_path):
     _, visual = stabilize_video(shaky, tmp_path / "v.mp4", Settings(fov=70.0))
     assert summary["gyro"] is None and summary["frames"] == 60
     assert any(n.startswith("gyro: not used, the gyro's motion does not match") for n in said)
+    assert [n for n in said if n.startswith("gyro")] == [
+        n for n in summary["notices"] if n.startswith("gyro")
+    ]  # --json's summary says what the run said (it held what was said before the work)
     assert np.allclose(planned.corrections(), visual.corrections())  # as without the log
     # one that turns 3 times as far as the video (max-heromode's: 6 times) gives way too
     thrice = sample_log(tmp_path / "thrice.csv", 3.0, source=shaky.parent / "gyro.csv")
