@@ -501,7 +501,9 @@ def _gyro_rotations(
         tell(f"gyro: not used, {reason}: stabilised from the video's own motion instead")
         return None
     scale = summary["motion_scale"]
-    if not MOTION_SCALE[0] <= scale <= MOTION_SCALE[1] and settings.gyro_fallback:
+    if MOTION_SCALE[0] <= scale <= MOTION_SCALE[1]:
+        return R, rolling, summary
+    if settings.gyro_fallback:
         # max-heromode's own gyro turns 6 times as far as its video, which the camera
         # steadied: stabilised from it, the clip would shake more than it does
         tell(
@@ -509,12 +511,11 @@ def _gyro_rotations(
             "stabilised in the camera): stabilised from the video's own motion instead"
         )
         return None
-    if not MOTION_SCALE[0] <= scale <= MOTION_SCALE[1]:
-        tell(
-            f"gyro: the video turns {scale:.2f} times as far as its gyro: a clip "
-            "stabilised in the camera (the output may shake more than the input), or "
-            "a focal length far off (--fov, --lens)"
-        )
+    tell(
+        f"gyro: the video turns {scale:.2f} times as far as its gyro: a clip "
+        "stabilised in the camera (the output may shake more than the input), or "
+        "a focal length far off (--fov, --lens)"
+    )
     return R, rolling, summary
 
 

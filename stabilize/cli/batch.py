@@ -132,9 +132,10 @@ def batch(
         run_or_fail(lambda: read_lens_profile(lens))
     run_or_fail(lambda: flow.check_weights(flow_name, raft_weights))
     jobs = _jobs(ctx.params, settings)
-    if workers and not ray and min(workers, len(jobs)) > default_workers():
+    most = default_workers()
+    if workers and not ray and min(workers, len(jobs)) > most:
         notice(
-            f"--workers {workers}: this machine runs {default_workers()} at once (a core each, "
+            f"--workers {workers}: this machine runs {most} at once (a core each, "
             f"and {BYTES_PER_WORKER / 2**30:.1f} GB of memory for a 1080p clip); more take as "
             "long or longer, and may be killed for memory"
         )
