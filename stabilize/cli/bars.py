@@ -23,15 +23,8 @@ from stabilize.progress import ProgressFactory
 T = TypeVar("T")
 
 
-@contextlib.contextmanager
-def progress_bar(
-    label: str, total: int | None, *, unit: str = "frames", quiet: bool = False
-) -> Iterator[Callable[[int], None]]:
-    """Yields ``advance(n)``; shows rate (units/s) and ETA on stderr."""
-    if quiet:
-        yield lambda n=1: None
-        return
-    columns = (
+def _stage_columns() -> tuple:
+    return (
         TextColumn("[bold]{task.description}"),
         BarColumn(),
         MofNCompleteColumn(),
@@ -40,30 +33,53 @@ def progress_bar(
         TimeElapsedColumn(),
         TimeRemainingColumn(),
     )
-    with Progress(*columns, console=Console(stderr=True), transient=False) as progress:
-        task = progress.add_task(label, total=total, rate="")
 
-        def advance(n: int = 1) -> None:
-            progress.advance(task, n)
-            speed = progress.tasks[0].speed
-            if speed:
-                progress.update(task, rate=f"{speed:.1f} {unit}/s")
+
+@contextlib.contextmanager
+def stage_bars(*, quiet: bool = False) -> Iterator[Callable[..., Callable[[int], None]]]:
+    """Yields ``bar(label, total, unit="frames")``, which adds a stage's bar below the last
+    one and returns its ``advance(n)`` (rate in units/s, and ETA, on stderr).
+
+    One live display holds every stage's bar: each stage's own display, on a console of
+    its own, drew over the last one's line, so a terminal's bar flickered between
+    "estimating" and "stabilising", and a log held them in reverse order. The bars stay
+    when the job ends; a failure clears them, leaving no half bar above its message."""
+    if quiet:
+        yield lambda label, total, unit="frames": lambda n=1: None
+        return
+    with Progress(*_stage_columns(), console=Console(stderr=True), transient=False) as progress:
+
+        def bar(label: str, total: int | None, unit: str = "frames") -> Callable[[int], None]:
+            task = progress.add_task(label, total=total, rate="")
+
+            def advance(n: int = 1) -> None:
+                progress.advance(task, n)
+                speed = next(t.speed for t in progress.tasks if t.id == task)
+                if speed:
+                    progress.update(task, rate=f"{speed:.1f} {unit}/s")
+
+            return advance
 
         try:
-            yield advance
+            yield bar
         except BaseException:
-            progress.live.transient = True  # a failure leaves no half bar above its message
+            progress.live.transient = True
             raise
 
 
+@contextlib.contextmanager
+def progress_bar(
+    label: str, total: int | None, *, unit: str = "frames", quiet: bool = False
+) -> Iterator[Callable[[int], None]]:
+    """Yields ``advance(n)`` of one bar (:func:`stage_bars`)."""
+    with stage_bars(quiet=quiet) as bar:
+        yield bar(label, total, unit)
+
+
 def with_bars(job: Callable[[ProgressFactory], T], *, quiet: bool = False) -> T:
-    """``job(bar)``, where ``bar(label, total)`` opens a progress bar for a stage; the
-    bars stay until the job is done, and are cleared when it fails."""
-    with contextlib.ExitStack() as stack:
-
-        def bar(label: str, total: int | None) -> Callable[[int], None]:
-            return stack.enter_context(progress_bar(label, total, quiet=quiet))
-
+    """``job(bar)``, where ``bar(label, total)`` opens a progress bar for a stage, below
+    the last stage's (:func:`stage_bars`)."""
+    with stage_bars(quiet=quiet) as bar:
         return job(bar)
 
 
