@@ -61,7 +61,8 @@ class Settings:
     gyro_offset: float | None = None
     gyro_axes: tuple | None = None  # R_cam_imu as nested tuples
     gyro_lpf: float | None = None  # Hz
-    readout_ms: float | str | None = None  # rolling shutter: ms, 'auto', or the log's value
+    # with a gyro: ms, 'auto', or None: the log's, the lens profile's, else estimated
+    readout_ms: float | str | None = None
     # rolling shutter without a gyro: 'auto' (estimated from the video), 'off', or ms
     rolling_shutter: float | str = "auto"
     # the most a rolling shutter's correction may shear or stretch a frame, percent

@@ -130,7 +130,7 @@ def _comparison(params: dict, bar: ProgressFactory):
     """The comparison the parsed options ``params`` ask for."""
     from stabilize.evaluate.compare import compare_video
     from stabilize.gyro import read_gyro
-    from stabilize.gyro.load import AUTO_FOR_SEQUENCE, gyro_log_for, readout_seconds
+    from stabilize.gyro.load import AUTO_FOR_SEQUENCE, gyro_log_for, starting_readout
     from stabilize.gyro.sync import SyncOptions
     from stabilize.video.sequence import is_pattern
     from stabilize.warp.lens import read_lens_profile
@@ -159,12 +159,13 @@ def _comparison(params: dict, bar: ProgressFactory):
         raise ValueError("--calibrate-focal fits a pinhole focal length; --lens brings its own")
     if camera is not None:
         settings = replace(settings, focal=float(camera.K[0, 0]))
-    # Unlike the stabiliser, compare estimates (None) a readout the log does not give.
+    # compare's 'auto' (its default) is the stabiliser's default: the log's, else the
+    # lens profile's, else estimated
     parsed = readout(params["readout_ms"], params["gyro"])
-    given = log.readout_s or (camera and camera.readout_s)
-    known = given if parsed == "auto" else readout_seconds(parsed, None)
+    option = None if parsed == "auto" else parsed
+    known, source = starting_readout(option, log.readout_s, camera and camera.readout_s)
     options = SyncOptions(
-        params["gyro_offset"], R_cam_imu, known, params["gyro_drift"], params["gyro_search"]
+        params["gyro_offset"], R_cam_imu, known, params["gyro_drift"], params["gyro_search"], source
     )
     announce_compiling()
     return compare_video(
@@ -202,15 +203,24 @@ def _video_and_times(
     return info, times
 
 
+# where the readout came from, in the description's words (given: nothing to add)
+READOUT_WORDS = {
+    "estimated": " (estimated)",
+    "none": " (not pinned down by the bands: taken as a global shutter)",
+    "log": " (the log's)",
+    "lens": " (the lens profile's)",
+}
+
+
 def _describe(summary: dict) -> str:
     """The comparison in three lines of text."""
-    estimated = " (estimated)" if summary["readout_estimated"] else ""
+    source = READOUT_WORDS.get(summary["readout_source"], "")
     return (
         f"{summary['frames']} pairs: AAE {summary['aae_deg']:.4f}°, median "
         f"{summary['median_deg']:.4f}°, p95 {summary['p95_deg']:.4f}° (pitch "
         f"{summary['aae_pitch_deg']:.4f}°, yaw {summary['aae_yaw_deg']:.4f}°, roll "
         f"{summary['aae_roll_deg']:.4f}°)\noffset {1000 * summary['offset_s']:+.2f} ms, readout "
-        f"{summary['readout_ms']:.1f} ms{estimated}, gyro "
+        f"{summary['readout_ms']:.1f} ms{source}, gyro "
         f"{summary['gyro_rate_hz']:.1f} Hz, focal {summary['focal_px']:.1f} px, speed "
         f"correlation {summary['speed_correlation']:.3f}\nR_cam_imu = "
         f"{np.round(np.array(summary['R_cam_imu']), 4).tolist()}"

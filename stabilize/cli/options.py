@@ -167,7 +167,8 @@ ReadoutOption = Annotated[
     str | None,
     typer.Option(
         help="Rolling-shutter readout, ms, or 'auto' to estimate it (with a gyro log). "
-        "Default: the log's own value, else none."
+        "Default: the log's own value, else the lens profile's, else estimated against the "
+        "gyro, else from the video alone."
     ),
 ]
 MaxStretchOption = Annotated[

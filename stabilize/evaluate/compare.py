@@ -112,6 +112,7 @@ class Comparison:
             "offset_s": self.sync.offset,
             "readout_ms": 1000.0 * self.sync.readout,
             "readout_estimated": self.sync.readout_estimated,
+            "readout_source": self.sync.readout_source,
             "drift_ppm": 1e6 * self.sync.drift,
             "aae_deg": float(err.mean()),
             "median_deg": float(np.median(err)),

@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.gyro.load import readout_seconds
+from stabilize.gyro.load import starting_readout
 from stabilize.gyro.log import GyroError, GyroLog
 from stabilize.gyro.rolling_shutter import frame_rotations, row_turns
 from stabilize.gyro.source import gyro_rotations
@@ -36,9 +36,9 @@ def gyro_path(
         # (a container may list one frame more than decodes: the track has the decoded)
         track = replace(track, times=np.asarray(stamps[: len(track.times)], dtype=np.float64))
     axes = None if settings.gyro_axes is None else np.array(settings.gyro_axes, dtype=float)
-    readout = readout_seconds(settings.readout_ms, log.readout_s or (lens and lens.readout_s))
+    readout, source = starting_readout(settings.readout_ms, log.readout_s, lens and lens.readout_s)
     options = SyncOptions(
-        settings.gyro_offset, axes, readout, settings.gyro_drift, settings.gyro_search
+        settings.gyro_offset, axes, readout, settings.gyro_drift, settings.gyro_search, source
     )
     att, sync = gyro_rotations(log, track, options)
     clock = sync.clock(track.times)
@@ -63,6 +63,7 @@ def gyro_path(
             "rate_hz": log.rate_hz,
             "readout_ms": 1000.0 * sync.readout,
             "readout_estimated": sync.readout_estimated,
+            "readout_source": sync.readout_source,
             "searched_whole_log": sync.searched_whole_log,
         },
     )

@@ -16,7 +16,7 @@ interpolated), which is what the visual estimate measures.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
 
 import numpy as np
@@ -60,17 +60,20 @@ def motion_scale(visual: NDArray, gyro: NDArray) -> float:
 class SyncOptions:
     """What is given, and what is searched, when a log is synchronised to a video: an
     ``offset`` (s), the axes ``R_cam_imu`` or a ``readout`` (s) given are kept (None:
-    estimated); ``search`` is the offset range, ± s; ``fit_drift`` also fits a clock drift."""
+    estimated); ``search`` is the offset range, ± s; ``fit_drift`` also fits a clock drift.
+    ``readout_source`` says where a readout given came from (``given``, ``log``, ``lens``)."""
 
     offset: float | None = None
     R_cam_imu: NDArray | None = None
     readout: float | None = 0.0
     fit_drift: bool = False
     search: float = 1.0
+    readout_source: str = "given"
 
     def synchronise(self, log: GyroLog, track: VisualTrack) -> Sync:
-        """:func:`synchronise` with these options."""
-        return synchronise(
+        """:func:`synchronise` with these options; the readout's source is this one's, or
+        ``estimated``, or ``none`` where the estimate was refused (0 is then taken)."""
+        sync = synchronise(
             log,
             track,
             search=(-self.search, self.search),
@@ -79,6 +82,9 @@ class SyncOptions:
             readout=self.readout,
             fit_drift=self.fit_drift,
         )
+        if self.readout is not None:
+            return replace(sync, readout_source=self.readout_source)
+        return replace(sync, readout_source="estimated" if sync.readout_estimated else "none")
 
 
 @dataclass(frozen=True)
@@ -92,6 +98,7 @@ class Sync:
     drift: float = 0.0  # gyro clock rate minus video clock rate (1e-6 = 1 ppm)
     origin: float = 0.0  # video time at which ``offset`` holds exactly
     searched_whole_log: bool = False  # the log's clock lay outside the search range
+    readout_source: str = "given"  # SyncOptions.synchronise's
 
     def lag(self, track: VisualTrack) -> NDArray[np.float64]:
         """Per pair, when its rotation was seen after the first row: readout × mean height."""

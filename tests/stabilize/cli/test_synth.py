@@ -13,7 +13,7 @@ def test_synth_command_writes_clip_truth_and_gyro(tmp_path):
     args = ["--seconds", "0.5", "--size", "320x180", "--procedural", "--bob-m", "0.03", "-q"]
     result = CliRunner().invoke(app, ["synth", str(out), *args])
     assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)
     assert summary["frames"] == 15
     for name in ("clip.mp4", "truth.csv", "gyro.csv", "timestamps.csv", "truth.json"):
         assert (out / name).is_file(), name

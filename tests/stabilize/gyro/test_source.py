@@ -69,7 +69,7 @@ def test_stabilising_from_the_gyro_beside_the_clip(tmp_path):
         ],
     )
     assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)
     assert abs(summary["gyro"]["offset_s"] - 0.35) < 1e-3
     assert abs(summary["gyro"]["motion_scale"] - 1) < 0.05
     assert summary["frames"] == 90 and out.is_file()
@@ -211,3 +211,38 @@ def test_readout_needs_the_gyro(tmp_path):
         app, ["run", str(SAMPLE / "clip.mp4"), str(out), "--readout-ms", "20", "-q"]
     )
     assert result.exit_code != 0 and "--gyro" in result.output and not out.exists()
+
+
+def test_a_readout_no_log_gives_is_estimated_against_the_gyro(rolling_clip, tmp_path):
+    # a log that gives no readout (phone-cc9's, a GoPro's) was taken for a global
+    # shutter, and nothing was corrected: phone-cc9 read 1.181 px of residual shake so,
+    # 1.082 at the 23.4 ms found against its gyro
+    told: list[str] = []
+    settings = Settings(gyro=rolling_clip / "gyro.csv", fov=70.0)
+    summary, planned = stabilize_video(
+        rolling_clip / "clip.mp4", tmp_path / "out.mp4", settings, notify=told.append
+    )
+    gyro = summary["gyro"]
+    assert gyro["readout_source"] == "estimated" and gyro["readout_ms"] == pytest.approx(25, abs=4)
+    assert planned.row_corrections is not None
+    assert any(t.startswith("rolling shutter: ") and "against the gyro" in t for t in told)
+
+
+def test_a_readout_the_gyro_does_not_pin_down_is_read_from_the_video(rolling_clip, tmp_path):
+    # with the offset given, the bands are not dated against the gyro (nor are karma's,
+    # whose smooth flight dates them poorly; its video reads 34.9 ms): the video's own
+    # estimate stands in, as it would without the log
+    meta = json.loads((rolling_clip / "truth.json").read_text())
+    told: list[str] = []
+    settings = Settings(gyro=rolling_clip / "gyro.csv", gyro_offset=meta["offset_s"], fov=70.0)
+    summary, planned = stabilize_video(
+        rolling_clip / "clip.mp4", tmp_path / "out.mp4", settings, notify=told.append
+    )
+    gyro = summary["gyro"]
+    assert gyro["readout_source"] == "video" and gyro["readout_ms"] == pytest.approx(25, abs=2.5)
+    assert planned.row_corrections is not None
+    assert any("from the video (the gyro does not pin it down)" in t for t in told)
+    # a readout given is used as it is, and no band is measured for it
+    settings = replace(settings, readout_ms=0.0)
+    summary, planned = stabilize_video(rolling_clip / "clip.mp4", tmp_path / "off.mp4", settings)
+    assert summary["gyro"]["readout_source"] == "given" and planned.row_corrections is None

@@ -1,6 +1,5 @@
 import json
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,7 +12,6 @@ from stabilize.gyro.axes import signed_permutations
 from stabilize.gyro.sync import synchronise, visual_rates
 from stabilize.motion.files import read_rotations
 from stabilize.motion.track import VisualTrack
-from stabilize.synth import SynthOptions, render_clip
 from tests.stabilize.helpers import SAMPLE, held_upright
 
 
@@ -76,7 +74,7 @@ def test_compare_command_on_a_rendered_clip(tmp_path):
         ],
     )
     assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)
     assert abs(summary["offset_s"] - meta["offset_s"]) < 1e-3
     assert summary["axes"] == "YXz" and summary["warning"] is None
     assert summary["aae_deg"] < 0.06 and summary["frames"] == 89
@@ -135,20 +133,12 @@ def test_a_log_that_cannot_cover_the_video_is_an_error(tmp_path):
     assert result.exit_code != 0 and "does not cover" in result.output
 
 
-@pytest.fixture(scope="module")
-def rolling_clip(tmp_path_factory) -> Path:
-    folder = tmp_path_factory.mktemp("rolling")
-    opts = SynthOptions(size=(270, 480), seconds=3.0, seed=5, shake_deg=1.5, rolling_shutter_ms=25)
-    render_clip(folder, opts)
-    return folder
-
-
 def test_readout_and_first_row_offset_are_estimated_under_a_rolling_shutter(rolling_clip):
     meta = json.loads((rolling_clip / "truth.json").read_text())
     args = [str(rolling_clip / "clip.mp4"), "--gyro", str(rolling_clip / "gyro.csv")]
     result = CliRunner().invoke(app, ["compare", *args, "--fov", "70", "-q", "--json"])
     assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)
     assert summary["readout_estimated"] and abs(summary["readout_ms"] - 25.0) < 4.0
     # About 2 ms here (1.92 with every vector voting, 2.05 with the textured ones, a 25th
     # of a frame): the bands' rows are dated by where their vectors start, not by where
@@ -159,8 +149,19 @@ def test_readout_and_first_row_offset_are_estimated_under_a_rolling_shutter(roll
     result = CliRunner().invoke(
         app, ["compare", *args, "--fov", "70", "--readout-ms", "0", "-q", "--json"]
     )
-    ignored = json.loads(result.output)
+    ignored = json.loads(result.stdout)
     assert ignored["offset_s"] - meta["offset_s"] > 8e-3 and ignored["readout_ms"] == 0.0
+
+
+def test_a_readout_the_bands_do_not_pin_down_is_said_to_be_so(rolling_clip):
+    # with the offset given, the bands are not dated against the gyro: the readout is
+    # then 0, which compare printed as "readout 0.0 ms", as though a global shutter
+    meta = json.loads((rolling_clip / "truth.json").read_text())
+    args = [str(rolling_clip / "clip.mp4"), "--gyro", str(rolling_clip / "gyro.csv")]
+    offset = ["--gyro-offset", str(meta["offset_s"])]
+    result = CliRunner().invoke(app, ["compare", *args, *offset, "--fov", "70", "-q"])
+    assert result.exit_code == 0, result.output
+    assert "readout 0.0 ms (not pinned down by the bands" in result.stdout
 
 
 def test_phone_cc9_offset_axes_and_readout(shared):
@@ -183,7 +184,7 @@ def test_phone_cc9_offset_axes_and_readout(shared):
         ],
     )
     assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)
     # The data README: offset 0 ± 4 ms from the frame start; gyro x is camera y and
     # gyro y camera x.
     assert abs(summary["offset_s"]) < 4e-3
@@ -211,7 +212,7 @@ def test_the_focal_length_is_calibrated_against_the_gyro():
     args = ["compare", str(SAMPLE / "clip.mp4"), "--gyro", str(SAMPLE / "gyro.csv")]
     result = CliRunner().invoke(app, [*args, "--fov", "60", "--calibrate-focal", "-q", "--json"])
     assert result.exit_code == 0, result.output
-    summary = json.loads(result.output)
+    summary = json.loads(result.stdout)
     assert summary["focal_calibrated"]
     assert summary["focal_px"] == pytest.approx(meta["focal_px"], rel=0.03)  # from 554 px
 
