@@ -69,6 +69,7 @@ from stabilize.video.sequence import (
     sequence_files,
 )
 from stabilize.video.streams import keep_streams
+from stabilize.warp.border import BORDERS
 from stabilize.warp.camera_path import CameraPath
 from stabilize.warp.lens import Lens, read_lens_profile
 from stabilize.warp.render import (
@@ -578,6 +579,7 @@ def check_settings(settings: Settings) -> None:
         (settings.flow in flow.BACKENDS, f"--flow must be one of {', '.join(flow.BACKENDS)}"),
         (settings.method in METHODS, f"--method must be one of {', '.join(METHODS)}"),
         (settings.crop in CROP_MODES, f"--crop must be one of {', '.join(CROP_MODES)}"),
+        (settings.border in BORDERS, f"--border must be one of {', '.join(BORDERS)}"),
         (
             settings.motion in MOTION_MODELS,
             f"--motion must be one of {', '.join(MOTION_MODELS)}",

@@ -54,6 +54,7 @@ class Settings:
     motion: str = "similarity"
     max_zoom: float = DEFAULT_MAX_ZOOM
     crop: str = "auto"  # zoom mode (stabilize.path.zoom.CROP_MODES)
+    border: str = "black"  # where a frame has no source (stabilize.warp.border.BORDERS)
     max_deg: float = 15.0  # the estimator's search range per frame pair
     preview: bool = False  # write original | stabilised side by side
     gyro: str | None = None  # a gyro log: the path comes from it, synchronised to the video

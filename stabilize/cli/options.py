@@ -27,6 +27,7 @@ from stabilize.settings import DEFAULTS, Settings
 from stabilize.video.bars import BARS_MODES
 from stabilize.video.encode import Encoding
 from stabilize.video.fields import DEINTERLACE_MODES
+from stabilize.warp.border import BORDERS
 
 FlowOption = Annotated[
     Literal[tuple(flow.BACKENDS)],
@@ -84,6 +85,13 @@ MaxZoomOption = Annotated[
 CropOption = Annotated[
     Literal[tuple(CROP_MODES)],
     typer.Option(help="auto (one zoom), dynamic (smoothly varying), none."),
+]
+BorderOption = Annotated[
+    Literal[tuple(BORDERS)],
+    typer.Option(
+        help="What shows where a frame has no source, which only --crop none lets into "
+        "view: black, edge (its edge pixels repeated) or mirror (the frame reflected)."
+    ),
 ]
 CodecOption = Annotated[
     str | None,
@@ -223,6 +231,7 @@ def job_settings(params: Mapping[str, Any]) -> Settings:
         motion=params["motion"],
         max_zoom=params["max_zoom"],
         crop=params["crop"],
+        border=params.get("border", DEFAULTS.border),
         preview=preview == "side-by-side",
         size=output_size(params["size"]),
         deinterlace=params.get("deinterlace", DEFAULTS.deinterlace),

@@ -66,20 +66,23 @@ class CameraPath:
         batch: Sequence[tuple[int, NDArray[np.uint8]]],
         device: str = "cpu",
         full_range: bool = False,
+        border: str = "black",
     ) -> list[NDArray[np.uint8]]:
         """Output frames of (k, frame) pairs, RGB or I420 (2-D; ``full_range``: its
-        black); on CUDA the batch is warped together (by homographies, or by the lens's or
-        the rows' maps)."""
+        black), ``border`` where they have no source (:mod:`stabilize.warp.border`); on
+        CUDA the batch is warped together (by homographies, or by the lens's or the rows'
+        maps)."""
         eight_bit = all(frame.dtype == np.uint8 for _, frame in batch)
         if not (device.startswith("cuda") and eight_bit):
-            return [self.warp(k, frame, full_range) for k, frame in batch]
-        return self.warp_together(batch, device, full_range)
+            return [self.warp(k, frame, full_range, border) for k, frame in batch]
+        return self.warp_together(batch, device, full_range, border)
 
     def warp_together(
         self,
         batch: Sequence[tuple[int, NDArray[np.uint8]]],
         device: str,
         full_range: bool = False,
+        border: str = "black",
     ) -> list[NDArray[np.uint8]]:
         """8-bit (k, frame) pairs warped as one batch with torch on ``device``."""
         frames = np.stack([frame for _, frame in batch])
@@ -89,14 +92,14 @@ class CameraPath:
             Hc = np.array([chroma_homography(h) for h in H])
 
             def warp(frames: NDArray, plane: int, fill: int) -> NDArray:
-                return warp_frames_torch(frames, Hc if plane else H, device, fill)
+                return warp_frames_torch(frames, Hc if plane else H, device, fill, border)
         else:
             h, w = frames.shape[1:3]
             size = (h * 2 // 3, w) if frames.ndim == 3 else (h, w)  # I420: the luma's
             coarse = np.stack([coarse_map(self.source(k), size) for k in ks])
 
             def warp(frames: NDArray, plane: int, fill: int) -> NDArray:
-                return remap_frames_torch(frames, coarse, device, fill, half=plane > 0)
+                return remap_frames_torch(frames, coarse, device, fill, plane > 0, border)
 
         if frames.ndim == 4:
             return list(warp(frames, 0, 0))
@@ -113,12 +116,18 @@ class CameraPath:
             return lens_source(self.lens, C, self.zoom[k], self.knot_rows)
         return rolling_source(homography(self.K, C, self.zoom[k]), self.knot_rows)
 
-    def warp(self, k: int, frame: NDArray[np.uint8], full_range: bool = False) -> NDArray[np.uint8]:
+    def warp(
+        self, k: int, frame: NDArray[np.uint8], full_range: bool = False, border: str = "black"
+    ) -> NDArray[np.uint8]:
         """Frame k of the output, from frame k of the input (RGB, or I420 when 2-D, whose
-        black depends on its range)."""
+        black depends on its range), ``border`` where it has no source."""
         planar = frame.ndim == 2
         if self.plain:
             H = self.homographies[k]
-            return warp_planes(frame, H, full_range) if planar else warp_frame(frame, H)
+            if planar:
+                return warp_planes(frame, H, full_range, border)
+            return warp_frame(frame, H, border)
         source = self.source(k)
-        return remap_planes(frame, source, full_range) if planar else remap_from(frame, source)
+        if planar:
+            return remap_planes(frame, source, full_range, border)
+        return remap_from(frame, source, border=border)

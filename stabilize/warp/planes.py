@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stabilize.video.i420 import black, join, split
+from stabilize.warp.border import opencv_border
 from stabilize.warp.frames import resize_image
 from stabilize.warp.remap import MAP_STEP, coarse_map, dense_map, half_knots, remap_with
 from stabilize.warp.sources import SourceMap
@@ -26,10 +27,11 @@ def chroma_homography(H: NDArray) -> NDArray[np.float64]:
 
 
 def warp_planes(
-    frame: NDArray[np.uint8], H: NDArray, full_range: bool = False
+    frame: NDArray[np.uint8], H: NDArray, full_range: bool = False, border: str = "black"
 ) -> NDArray[np.uint8]:
-    """cv2.warpPerspective of every plane by H (chroma by S H S⁻¹); black outside (in
-    the frame's range)."""
+    """cv2.warpPerspective of every plane by H (chroma by S H S⁻¹); outside, black (in
+    the frame's range) or the ``border`` named (:mod:`stabilize.warp.border`)."""
+    mode = opencv_border(border)
     Hc = chroma_homography(H)
     out = np.empty_like(frame)
     # Each plane is warped straight into its place in the output: no joining copy.
@@ -37,20 +39,28 @@ def warp_planes(
         split(frame), split(out), (H, Hc, Hc), black(frame, full_range), strict=True
     ):
         size = (plane.shape[1], plane.shape[0])
-        cv2.warpPerspective(plane, M, size, dst=dst, flags=cv2.INTER_LINEAR, borderValue=fill)
+        cv2.warpPerspective(
+            plane, M, size, dst=dst, flags=cv2.INTER_LINEAR, borderMode=mode, borderValue=fill
+        )
     return out
 
 
-def remap_planes(frame: NDArray, source: SourceMap, full_range: bool = False) -> NDArray:
+def remap_planes(
+    frame: NDArray, source: SourceMap, full_range: bool = False, border: str = "black"
+) -> NDArray:
     """Warp every plane by a map ``source`` (full-size output pixels → input pixels);
-    chroma sees the same map through the half-size coordinates; black outside."""
+    chroma sees the same map through the half-size coordinates; black outside, or the
+    ``border`` named."""
     y, u, v = split(frame)
     coarse = coarse_map(source, y.shape)
     dense = dense_map(coarse, y.shape)
     half = dense_map(half_knots(coarse), u.shape, MAP_STEP // 2)
     fill = black(frame, full_range)
     return join(
-        remap_with(y, dense, fill[0]), remap_with(u, half, fill[1]), remap_with(v, half, fill[2])
+        *(
+            remap_with(plane, where, value, border)
+            for plane, where, value in zip((y, u, v), (dense, half, half), fill, strict=True)
+        )
     )
 
 

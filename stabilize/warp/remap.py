@@ -17,6 +17,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from stabilize.warp.border import opencv_border
 from stabilize.warp.sources import SourceMap
 
 # Output pixels between exactly computed points of a map. Through a fisheye lens of 104°
@@ -26,17 +27,18 @@ MAP_STEP = 32
 NO_SOURCE = -1e4  # far outside any frame: where a map has no source
 
 
-def remap_from(frame: NDArray, source: SourceMap, fill: int = 0) -> NDArray:
+def remap_from(frame: NDArray, source: SourceMap, fill: int = 0, border: str = "black") -> NDArray:
     """Warp a frame by any smooth map ``source``: output pixels (M, 2) → input pixels
     (NaN: no source), exact at the knots and bilinear between."""
-    return remap_with(frame, dense_map(coarse_map(source, frame.shape[:2]), frame.shape[:2]), fill)
+    size = frame.shape[:2]
+    return remap_with(frame, dense_map(coarse_map(source, size), size), fill, border)
 
 
-def remap_with(frame: NDArray, dense: NDArray, fill: int = 0) -> NDArray:
-    """``cv2.remap`` of a frame by a dense map (H, W, 2) of input pixels."""
-    return cv2.remap(
-        frame, dense, None, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=fill
-    )
+def remap_with(frame: NDArray, dense: NDArray, fill: int = 0, border: str = "black") -> NDArray:
+    """``cv2.remap`` of a frame by a dense map (H, W, 2) of input pixels; outside,
+    ``fill`` or the ``border`` named (:mod:`stabilize.warp.border`)."""
+    mode = opencv_border(border)
+    return cv2.remap(frame, dense, None, cv2.INTER_LINEAR, borderMode=mode, borderValue=fill)
 
 
 def coarse_map(source: SourceMap, size: tuple[int, int]) -> NDArray[np.float32]:

@@ -105,7 +105,9 @@ def render(
             for batch in batches(frames(), WARP_BATCH if settings.device == "cuda" else 1):
                 for frame, warped in zip(
                     (f for _, f in batch),
-                    planned.warp_many(batch, settings.device, info.colour.full_range),
+                    planned.warp_many(
+                        batch, settings.device, info.colour.full_range, settings.border
+                    ),
                     strict=True,
                 ):
                     warped = as_written(warped)
