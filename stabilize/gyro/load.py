@@ -8,7 +8,13 @@ from dataclasses import replace
 from pathlib import Path
 
 from stabilize.gyro.log import GyroError, GyroLog
-from stabilize.gyro.readers import GYRO_SIDECARS, carries_gyro, read_gyro, unread_telemetry
+from stabilize.gyro.readers import (
+    GYRO_SIDECARS,
+    carries_gyro,
+    is_gyro_log,
+    read_gyro,
+    unread_telemetry,
+)
 from stabilize.settings import Settings
 
 # --gyro auto looks beside a clip for a log of its name: an image sequence has none
@@ -63,12 +69,22 @@ def starting_readout(
 
 def find_gyro_log(clip: str | Path) -> Path | None:
     """``--gyro auto``'s log for ``clip``: one beside it of the same name (the first of
-    :data:`GYRO_SIDECARS`), else the clip itself where its camera recorded its gyro in
-    it (:func:`carries_gyro`); None where there is neither."""
+    :data:`GYRO_SIDECARS` that is a ``.gcsv`` or begins as a gyro log: not the clip's
+    notes, :func:`is_gyro_log`), else the clip itself where its camera recorded its gyro
+    in it (:func:`carries_gyro`); None where there is neither."""
     clip = Path(clip)
-    beside = (clip.with_suffix(suffix) for suffix in GYRO_SIDECARS)
-    found = next((path for path in beside if path.is_file()), None)
+    found = next((path for path in _beside(clip) if _taken(path)), None)
     return found or (clip if carries_gyro(clip) else None)
+
+
+def _beside(clip: Path) -> list[Path]:
+    """The files beside ``clip`` of its name that a gyro log of it would be."""
+    return [path for s in GYRO_SIDECARS if (path := clip.with_suffix(s)).is_file()]
+
+
+def _taken(path: Path) -> bool:
+    # a .gcsv is a log by its name: one that does not read is refused, not passed over
+    return path.suffix.lower() == ".gcsv" or is_gyro_log(path)
 
 
 def gyro_log_for(clip: str | Path) -> Path:
@@ -76,8 +92,11 @@ def gyro_log_for(clip: str | Path) -> Path:
     found = find_gyro_log(clip)
     if found is None:
         sidecars = ", ".join(GYRO_SIDECARS)
+        others = [path.name for path in _beside(Path(clip))]
+        passed = f" ({', '.join(others)} beside it: no gyro log)" if others else ""
         raise GyroError(
-            f"--gyro auto: no gyro log beside {clip} ({sidecars}), nor in it{unread_telemetry()}"
+            f"--gyro auto: no gyro log beside {clip} ({sidecars}){passed}, nor in it"
+            f"{unread_telemetry()}"
         )
     return found
 

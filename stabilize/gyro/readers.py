@@ -223,15 +223,7 @@ def read_named_csv(
         delimiter = _delimiter(header)
         named = [_column(n) for n in next(csv.reader([header], delimiter=delimiter), [])]
         names = [n for n, _ in named]
-        sensorlogger = {"seconds_elapsed", "x", "y", "z"} <= set(names)
-        if time_column is None:
-            time_column = (
-                "seconds_elapsed"
-                if sensorlogger
-                else _pick(names, ("t", "time", "timestamp", "t_s"))
-            )
-        axes = columns or tuple(_pick(names, (a, f"g{a}", f"gyro_{a}", f"w{a}")) for a in "xyz")
-        wanted = [time_column.lower(), *(c.lower() for c in axes)]
+        wanted = _wanted_columns(names, time_column, columns)
         missing = [c for c in wanted if c not in names]
         if missing:
             raise GyroError(f"{path}:1: no column named {', '.join(missing)} (have {names})")
@@ -263,6 +255,38 @@ def read_named_csv(
     return GyroLog(
         data[:, 0] * TIME_UNITS[time_unit], data[:, 1:] * RATE_UNITS[rate_unit], str(path)
     )
+
+
+def _wanted_columns(
+    names: list[str],
+    time_column: str | None = None,
+    columns: tuple[str, str, str] | None = None,
+) -> list[str]:
+    """The time and x, y, z rate columns a CSV whose header names ``names`` is read by:
+    those given, else Sensor Logger's, else the first of the usual names present."""
+    if time_column is None:
+        sensorlogger = {"seconds_elapsed", "x", "y", "z"} <= set(names)
+        times = ("t", "time", "timestamp", "t_s")
+        time_column = "seconds_elapsed" if sensorlogger else _pick(names, times)
+    axes = columns or tuple(_pick(names, (a, f"g{a}", f"gyro_{a}", f"w{a}")) for a in "xyz")
+    return [time_column.lower(), *(c.lower() for c in axes)]
+
+
+def is_gyro_log(path: str | Path) -> bool:
+    """Whether a file begins as a gyro log of one of the formats read here: a Gyroflow
+    header, four numbers, or a CSV header naming a time column and x, y, z rate columns.
+    A clip's notes of its name (``clip.txt``) do not, and ``--gyro auto`` leaves them be:
+    it refused the clip ("no column named t, x, y, z")."""
+    try:
+        fmt = detect_format(path)
+    except GyroError:
+        return False
+    if fmt != "csv":
+        return True
+    with open(path, newline="", encoding="utf-8-sig", errors="replace") as f:
+        header = f.readline()
+    names = [_column(n)[0] for n in next(csv.reader([header], delimiter=_delimiter(header)), [])]
+    return set(_wanted_columns(names)) <= set(names)
 
 
 def _pick(names: list[str], candidates: tuple[str, ...]) -> str:
