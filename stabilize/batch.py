@@ -283,7 +283,7 @@ def run_job(job: Job, settings, on_frames: Callable[[int], None] | None = None) 
 
     ``on_frames(n)`` hears of every n frames written (a worker reports on its queue).
     """
-    from stabilize.pipeline import stabilize_video
+    from stabilize.pipeline import COMPILING, stabilize_video
 
     on_frames = on_frames or _report_frames
     counted = [0]
@@ -305,11 +305,16 @@ def run_job(job: Job, settings, on_frames: Callable[[int], None] | None = None) 
     row["settings"] = settings_key(settings)
     notices: list[str] = []  # what the file's run would say (they were lost in a batch)
     row["notices"] = notices
+
+    def note(message: str) -> None:
+        if not message.startswith(COMPILING):  # the batch's, said once: not of this file
+            notices.append(message)
+
     try:
         if job.gyro:
             settings = replace(settings, **gyro_settings(Path(job.gyro), Path(job.source)))
         summary, _ = stabilize_video(
-            job.source, job.output, settings, overwrite=True, progress=stage, notify=notices.append
+            job.source, job.output, settings, overwrite=True, progress=stage, notify=note
         )
         row.update(
             status="done",

@@ -383,13 +383,16 @@ def bars_notice(info: VideoInfo) -> tuple[str, ...]:
     )
 
 
+COMPILING = "compiling the estimator's kernels"
+
+
 def compiling_notice() -> tuple[str, ...]:
     """A notice, the first time only, that the estimator's kernels are being compiled."""
     from rotation.cache import cache_dir, kernels_cached
 
     if kernels_cached():
         return ()
-    return (f"compiling the estimator's kernels: about 20 s, once (cached in {cache_dir()})",)
+    return (f"{COMPILING}: about 20 s, once (cached in {cache_dir()})",)
 
 
 def dates_rows(settings: Settings, log: GyroLog | None = None, lens: Lens | None = None) -> bool:

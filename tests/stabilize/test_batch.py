@@ -133,6 +133,21 @@ def test_each_files_notices_are_kept_in_the_manifest(folder, tmp_path):
     assert "audio #1: aac → libmp3lame for AVI" in (out / "manifest.csv").read_text()
 
 
+def test_a_files_notices_leave_out_the_batchs_own(folder, tmp_path, monkeypatch):
+    # the first file of each worker listed "compiling the estimator's kernels", which the
+    # batch says once for all of them
+    import stabilize.batch as batch
+    import stabilize.pipeline as pipeline
+    from stabilize import Settings
+
+    said = f"{pipeline.COMPILING}: about 20 s, once"
+    monkeypatch.setattr(pipeline, "compiling_notice", lambda: (said,))
+    (job,) = find_jobs(folder, tmp_path / "out", "a.mp4")
+    row = batch.run_job(job, Settings(), lambda n: None)
+    assert row["status"] == "done" and row["notices"]  # the file's own are kept
+    assert not any(n.startswith(pipeline.COMPILING) for n in row["notices"])
+
+
 def test_a_killed_run_leaves_nothing_unfinished_under_a_final_name(folder, tmp_path):
     out = tmp_path / "out"
     proc = subprocess.Popen(
