@@ -541,7 +541,8 @@ def _with_readout(
 
     summary = gyro[2]
     if summary["readout_source"] == "estimated":
-        tell(f"rolling shutter: {summary['readout_ms']:.1f} ms (estimated against the gyro)")
+        found = f"{summary['readout_ms']:.1f} ms" if summary["readout_ms"] else "global shutter"
+        tell(f"rolling shutter: {found} (estimated against the gyro)")
     if summary["readout_source"] != "none" or track.bands is None:
         return gyro
     readout, _ = readout_for("auto", track)

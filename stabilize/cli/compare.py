@@ -215,6 +215,8 @@ READOUT_WORDS = {
 def _describe(summary: dict) -> str:
     """The comparison in three lines of text."""
     source = READOUT_WORDS.get(summary["readout_source"], "")
+    if summary["readout_source"] == "estimated" and not summary["readout_ms"]:
+        source = " (estimated: a global shutter)"
     return (
         f"{summary['frames']} pairs: AAE {summary['aae_deg']:.4f}°, median "
         f"{summary['median_deg']:.4f}°, p95 {summary['p95_deg']:.4f}° (pitch "

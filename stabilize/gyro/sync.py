@@ -41,6 +41,11 @@ IMPOSSIBLE_SCALE = (0.1, 10.0)
 MIN_COVERAGE = 0.8  # share of the frame pairs the log must cover (camera logs stop early)
 MAX_DRIFT = 2e-3  # clock-rate difference searched with fit_drift (crystals: ~1e-5..1e-4)
 MAX_READOUT_STDERR = 0.15  # of a frame interval: a less certain readout is not used
+# A readout within this many σ of 0, or under MIN_READOUT, cannot be told from none: a
+# global shutter (the rendered global-shutter sample read 0.5 ms against its gyro, and
+# was corrected by it). The video's own estimate (stabilize.shutter) keeps the same rule.
+SIGNIFICANT = 3.0
+MIN_READOUT = 0.001  # s
 
 
 def motion_scale(visual: NDArray, gyro: NDArray) -> float:
@@ -330,6 +335,8 @@ def estimate_readout(
     if stderr > MAX_READOUT_STDERR * frame or not -0.1 * frame < slope < 1.1 * frame:
         return offset, None
     readout = float(np.clip(slope, 0.0, frame))
+    if readout < max(SIGNIFICANT * stderr, MIN_READOUT):
+        readout = 0.0  # a global shutter: the offset is the bands' mean, every row's
     return float(np.average(y - readout * x, weights=w)), readout
 
 

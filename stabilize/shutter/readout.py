@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rotation import so3
-from stabilize.gyro.sync import golden_section
+from stabilize.gyro.sync import MIN_READOUT, SIGNIFICANT, golden_section
 from stabilize.motion.track import VisualTrack
 from stabilize.shutter.attitude import Bands, Spline, fit_attitude, knots_for
 from stabilize.video.decode import frame_interval
@@ -31,8 +31,6 @@ GRID = 29  # readouts tried across -0.2..1.2 frame intervals
 MAX_SEARCH_PAIRS = 900  # pairs the readout is searched on (30 s at 30 fps)
 MIN_PAIRS = 20  # pairs with three usable bands, fewest that date the rows
 MAX_STDERR = 0.06  # of a frame interval (2 ms at 30 fps): a less certain readout is refused
-SIGNIFICANT = 3.0  # an estimate within this many σ of 0, or under MIN_READOUT, is 0
-MIN_READOUT = 0.001  # s
 LONGEST, SHORTEST = 1.05, -0.1  # frame intervals: readouts outside these are impossible
 # The halves of the searched pairs must agree (halves_disagree). Measured, the halves'
 # readouts (ms) and how many σ apart: phone-cc9 24.7 and 32.3, 2.4 σ (its gyro: 25.4),

@@ -76,6 +76,11 @@ def test_stabilising_from_the_gyro_beside_the_clip(tmp_path):
     assert abs(summary["gyro"]["offset_s"] - 0.35) < 1e-3
     assert abs(summary["gyro"]["motion_scale"] - 1) < 0.05
     assert summary["frames"] == 90 and out.is_file()
+    # a global shutter, its readout estimated against the gyro: not the 0.5 ms it read
+    # (within 3σ of none), which corrected its rows by it
+    assert summary["gyro"]["readout_source"] == "estimated"
+    assert summary["gyro"]["readout_ms"] == 0.0
+    assert "rolling shutter: global shutter (estimated against the gyro)" in summary["notices"]
 
 
 def test_gyro_auto_with_no_log_beside_or_in_the_clip_is_refused(tmp_path):
