@@ -84,7 +84,10 @@ MaxZoomOption = Annotated[
 ]
 CropOption = Annotated[
     Literal[tuple(CROP_MODES)],
-    typer.Option(help="auto (one zoom), dynamic (smoothly varying), none."),
+    typer.Option(
+        help="auto (one zoom), dynamic (smoothly varying), none (the frames' moving edges "
+        "show: --border fills them)."
+    ),
 ]
 BorderOption = Annotated[
     Literal[tuple(BORDERS)],
