@@ -146,9 +146,9 @@ def _comparison(params: dict, bar: ProgressFactory):
     R_cam_imu = axes_matrix(params["gyro_axes"])
     calibrate = params["calibrate_focal"]
     gyro, video = params["gyro"], params["video"]
-    if str(gyro) == "auto" and is_pattern(video):
-        raise ValueError(AUTO_FOR_SEQUENCE)
     auto = str(gyro) == "auto"  # found beside the video, once it is known to be one
+    if auto and is_pattern(video):
+        raise ValueError(AUTO_FOR_SEQUENCE)
     log = None if auto else read_gyro(gyro, params["gyro_format"])
     info, times = _video_and_times(
         video, params["start_number"], params["fps"], params["gyro_timestamps"]

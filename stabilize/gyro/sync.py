@@ -16,7 +16,7 @@ interpolated), which is what the visual estimate measures.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
@@ -76,9 +76,8 @@ class SyncOptions:
     readout_source: str = "given"
 
     def synchronise(self, log: GyroLog, track: VisualTrack) -> Sync:
-        """:func:`synchronise` with these options; the readout's source is this one's, or
-        ``estimated``, or ``none`` where the estimate was refused (0 is then taken)."""
-        sync = synchronise(
+        """:func:`synchronise` with these options."""
+        return synchronise(
             log,
             track,
             search=(-self.search, self.search),
@@ -86,10 +85,8 @@ class SyncOptions:
             R_cam_imu=self.R_cam_imu,
             readout=self.readout,
             fit_drift=self.fit_drift,
+            readout_source=self.readout_source,
         )
-        if self.readout is not None:
-            return replace(sync, readout_source=self.readout_source)
-        return replace(sync, readout_source="estimated" if sync.readout_estimated else "none")
 
 
 @dataclass(frozen=True)
@@ -99,11 +96,17 @@ class Sync:
     bias: NDArray[np.float64]  # rad/s, in IMU axes
     correlation: float  # of the angular speeds at the offset
     readout: float = 0.0  # s, rolling-shutter readout (first to last row); 0: global
-    readout_estimated: bool = False
+    # where the readout came from: given (or the log's, the lens profile's), "estimated",
+    # or "none" where the estimate was refused (0 is then taken)
+    readout_source: str = "given"
     drift: float = 0.0  # gyro clock rate minus video clock rate (1e-6 = 1 ppm)
     origin: float = 0.0  # video time at which ``offset`` holds exactly
     searched_whole_log: bool = False  # the log's clock lay outside the search range
-    readout_source: str = "given"  # SyncOptions.synchronise's
+
+    @property
+    def readout_estimated(self) -> bool:
+        """Whether the readout was estimated from the bands (not given, not refused)."""
+        return self.readout_source == "estimated"
 
     def lag(self, track: VisualTrack) -> NDArray[np.float64]:
         """Per pair, when its rotation was seen after the first row: readout × mean height."""
@@ -373,6 +376,7 @@ def synchronise(
     readout: float | None = None,
     fit_drift: bool = False,
     max_drift: float = MAX_DRIFT,
+    readout_source: str = "given",
 ) -> Sync:
     """Offset, axes, bias (and readout) of ``log`` against a clip's visual rotations.
 
@@ -381,7 +385,7 @@ def synchronise(
     is estimated when not given and the track has band rotations; otherwise it is 0 (a
     global shutter, or the offset of the rows the rotations were seen on). ``fit_drift``
     also fits a linear clock drift within ±``max_drift`` (long clips; a few ms over the
-    clip are needed to see it).
+    clip are needed to see it). ``readout_source`` names where a readout given came from.
     """
     gyro = IntervalRates(log)
     times = track.times
@@ -401,7 +405,8 @@ def synchronise(
     R, bias = fit_axes(w_vis, gyro(times, delta), R_cam_imu)
     fit = offset is None
     delta, R, bias = refine_offset_and_axes(gyro, times, w_vis, delta, 0.0, fit, R_cam_imu, R, bias)
-    estimated = readout is None and track.bands is not None and offset is None
+    given = readout is not None  # kept as it is
+    estimated = not given and track.bands is not None and offset is None
     if estimated:
         delta, readout = estimate_readout(gyro, track, R, bias, delta)
         estimated = readout is not None
@@ -428,4 +433,6 @@ def synchronise(
         delta, R, bias = refine_offset_and_axes(
             gyro, drifted(times, drift, times[0]), w_vis, delta, lag, fit, R_cam_imu, R, bias
         )
-    return Sync(delta, R, bias, corr, readout, estimated, drift, float(times[0]), whole)
+    if not given:
+        readout_source = "estimated" if estimated else "none"
+    return Sync(delta, R, bias, corr, readout, readout_source, drift, float(times[0]), whole)

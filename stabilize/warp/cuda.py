@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from stabilize.warp.border import torch_padding
+
 
 def warp_frames_torch(
     frames: NDArray[np.uint8],
@@ -22,8 +24,6 @@ def warp_frames_torch(
     """
     import kornia
     import torch
-
-    from stabilize.warp.border import torch_padding
 
     planar = frames.ndim == 3
     src = torch.from_numpy(np.ascontiguousarray(frames)).to(device)
@@ -59,7 +59,6 @@ def remap_frames_torch(
     import torch
     import torch.nn.functional as F
 
-    from stabilize.warp.border import torch_padding
     from stabilize.warp.remap import MAP_STEP, half_knots
 
     planar = frames.ndim == 3
