@@ -22,6 +22,11 @@ QUICKTIME_AUDIO = frozenset({"aac", "mp3", "alac", "ac3", "eac3", "opus", "flac"
 # track of more down to its most): AC-3 holds 5.1, as DVDs carry it
 MAX_CHANNELS = {"libmp3lame": 2, "mp2": 2, "ac3": 6}
 QUICKTIME = ("-movflags", "+faststart+use_metadata_tags")  # moov first; keep custom tags
+# What FFmpeg reads from an MP4's or MOV's ftyp box as the file's metadata: they name the
+# source's file type, not the footage, and copied over they were written again as tags
+# beside the output's own box (MP4 and MOV read "qt  ;qt  ", and each run added one;
+# Matroska wrote MAJOR_BRAND tags)
+FILE_TYPE_KEYS = ("major_brand", "minor_version", "compatible_brands")
 
 
 @dataclass(frozen=True)

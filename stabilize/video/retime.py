@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stabilize.video.binary import local
+from stabilize.video.containers import FILE_TYPE_KEYS
 
 TIMESCALE = 90_000  # ticks per second of retimed video (MPEG's clock)
 
@@ -86,7 +87,7 @@ def retime(
         chaptered = bool(inp.chapters())
         kept = [s for s in inp.streams if not _rewritten(s, video, chaptered)]
         streams = {s.index: out.add_stream_from_template(s) for s in kept}
-        out.metadata.update(inp.metadata)
+        out.metadata.update({k: v for k, v in inp.metadata.items() if k not in FILE_TYPE_KEYS})
         for s in kept:
             streams[s.index].metadata.update(s.metadata)
             streams[s.index].disposition = s.disposition  # which track plays by default

@@ -16,7 +16,7 @@ WebM keep it as the video's tag, and other containers lose it, with a notice.
 from __future__ import annotations
 
 from stabilize.video.binary import local
-from stabilize.video.containers import MAX_CHANNELS, Container
+from stabilize.video.containers import FILE_TYPE_KEYS, MAX_CHANNELS, Container
 from stabilize.video.encode import Mux
 from stabilize.video.probe import Stream, VideoInfo
 
@@ -62,6 +62,8 @@ def keep_streams(info: VideoInfo, container: Container, video_delay: float = 0.0
         kept.append(stream.index)
     # One mapping per stream: any explicit one turns FFmpeg's per-stream default off.
     args += ["-map_metadata", "1", "-map_metadata:s:0", f"1:s:{_first_video(info)}"]
+    for key in FILE_TYPE_KEYS:  # an empty value leaves the key out
+        args += ["-metadata", f"{key}="]
     if timecode:
         args += ["-metadata:s:0", f"timecode={timecode}"]
     titles = {s.index: s.title for s in info.streams}

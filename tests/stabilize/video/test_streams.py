@@ -115,6 +115,16 @@ def test_the_files_metadata_is_kept(kept):
         assert tags["creation_time"].startswith("2024-05-01T10:00:00")
 
 
+def test_the_source_files_type_is_not_copied_as_tags(kept):
+    # the source's ftyp box, read as metadata, was written again as tags: MP4 then read
+    # "isom;isom" (one more each run) and Matroska carried MAJOR_BRAND
+    tags = {k.lower(): v for k, v in kept[2]["file"][0].items()}
+    if kept[0].suffix == ".mkv":
+        assert not {"major_brand", "minor_version", "compatible_brands"} & tags.keys()
+    else:
+        assert ";" not in tags["major_brand"] + tags["minor_version"]
+
+
 def test_the_video_is_the_default_track(kept):
     # Matroska marked the piped video not the default, which players read as "not shown"
     with av.open(str(kept[0])) as c:
@@ -382,6 +392,7 @@ def test_a_variable_rate_phone_clip_keeps_its_tags_and_plays_on_apples_players(t
     assert np.ptp(np.diff(frame_times(out))) > 0.01  # remuxed at its variable rate
     with av.open(str(out)) as c:
         assert tags.items() <= dict(c.metadata).items()
+        assert ";" not in c.metadata["major_brand"]  # its own file type only, once
         assert c.streams.video[0].codec_tag == "hvc1"
         assert c.streams.video[0].metadata["timecode"] == "01:02:03:04"
         timecodes = [s.metadata.get("timecode") for s in c.streams.data]
