@@ -52,7 +52,7 @@ from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Encoding, Mux
 from stabilize.video.encoders import unused_options
 from stabilize.video.fields import DEINTERLACE_MODES, field_times
-from stabilize.video.i420 import chroma, pipe_format
+from stabilize.video.i420 import chroma, finer, pipe_format
 from stabilize.video.preflight import (
     check_encoder,
     check_streams,
@@ -77,7 +77,6 @@ from stabilize.warp.render import (
     encoded_size,
     frame_size,
     output_encoding,
-    piped_format,
     render,
     shown_notice,
 )
@@ -244,7 +243,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     notices += encoder_notice(encoding, settings.encoding.codec_for(container))
     notices += unused_options(encoding.codec, encoding.crf, encoding.preset)
     notices += shown_notice(times, container)
-    notices += pipe_notices(info, piped_format(info, settings), encoding)
+    notices += pipe_notices(info, encoding)
     if not settings.size and frame_size(info, settings) != info.shown_framed_size:
         (h, w), (sh, sw) = frame_size(info, settings), info.shown_framed_size
         notices += (
@@ -266,11 +265,11 @@ def encoder_notice(encoding: Encoding, default: str) -> tuple[str, ...]:
     )
 
 
-def pipe_notices(info: VideoInfo, piped: str, encoding: Encoding) -> tuple[str, ...]:
-    """Notices for what of the source's picture does not reach the output: what the
-    frames piped to the encoder as ``piped`` cannot carry (Dolby Vision's and HDR10+'s
-    metadata, closed captions, alpha, colour finer than 4:2:0, depth), or what the
-    ``encoding`` cannot write (HDR10's static metadata, depth)."""
+def pipe_notices(info: VideoInfo, encoding: Encoding) -> tuple[str, ...]:
+    """Notices for what of the source's picture does not reach the output: what cannot
+    travel through the pipe to the encoder (Dolby Vision's and HDR10+'s metadata, closed
+    captions, alpha), or what the ``encoding`` cannot write (colour as fine, depth,
+    HDR10's static metadata)."""
     notices = dolby_vision_notice(info.colour.dolby_vision)
     if info.colour.hdr10_plus:
         notices += (
@@ -288,18 +287,13 @@ def pipe_notices(info: VideoInfo, piped: str, encoding: Encoding) -> tuple[str, 
             f"the source's alpha (transparency, {info.pix_fmt}) is left out: the frames "
             "are stabilised and written without it",
         )
-    notices += chroma_notice(info.pix_fmt, piped, encoding.pix_fmt)
-    if pipe_format(info.pix_fmt) != "yuv420p":  # a source of 10 bits or more
-        if pipe_format(piped) == "yuv420p":  # RGB, where a side is odd
-            notices += (
-                f"{info.pix_fmt} video written at 8 bits: with an odd side, its frames "
-                "travel to the encoder as 8-bit RGB",
-            )
-        elif pipe_format(encoding.pix_fmt) == "yuv420p":
-            notices += (
-                f"{info.pix_fmt} video written at 8 bits: {encoding.codec} "
-                f"({encoding.pix_fmt}) holds no more",
-            )
+    notices += chroma_notice(info.pix_fmt, encoding)
+    deep = pipe_format(info.pix_fmt) != "yuv420p"  # a source of 10 bits or more
+    if deep and pipe_format(encoding.pix_fmt) == "yuv420p":
+        notices += (
+            f"{info.pix_fmt} video written at 8 bits: {encoding.codec} "
+            f"({encoding.pix_fmt}) holds no more",
+        )
     if info.colour.hdr10_lost(encoding.codec):
         notices += (
             f"HDR10's mastering display and light levels left out: {encoding.codec} does "
@@ -308,16 +302,18 @@ def pipe_notices(info: VideoInfo, piped: str, encoding: Encoding) -> tuple[str, 
     return notices
 
 
-def chroma_notice(source: str, piped: str, written: str) -> tuple[str, ...]:
-    """A notice where the source's colour is finer than 4:2:0 (a camera's or ProRes's
-    4:2:2, 4:4:4, RGB pictures) and is halved on the way: the frames travel to the
-    encoder as 4:2:0 (``piped``), or are encoded so (``written``)."""
-    finer = chroma(source) in ("4:2:2", "4:4:0", "4:4:4")
-    if not finer or (chroma(piped) != "4:2:0" and chroma(written) != "4:2:0"):
+def chroma_notice(source: str, encoding: Encoding) -> tuple[str, ...]:
+    """A notice where the source's colour is finer than the ``encoding`` writes it: a
+    camera's or ProRes's 4:2:2, 4:4:4 or RGB pictures written as 4:2:0, which every
+    player plays. (It travels whole to an encoder that keeps it:
+    :func:`stabilize.warp.render.piped_format`.)"""
+    written = encoding.pix_fmt
+    if not finer(source, written):
         return ()
     return (
-        f"the source's {chroma(source)} colour ({source}) is halved to 4:2:0: the frames "
-        "travel to the encoder as 4:2:0",
+        f"the source's {chroma(source)} colour ({source}) is written as {chroma(written)} "
+        f"({written}), as {encoding.codec} writes it here; ProRes, DNxHR (--codec "
+        "prores_ks, dnxhd), PNG and TIFF keep finer colour",
     )
 
 

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from stabilize.video.binary import drain, ffmpeg_exe, local, widen_pipe
 from stabilize.video.colour import UNKNOWN, Colour
 from stabilize.video.containers import Container, container_for
-from stabilize.video.encoders import DEFAULT_PRESET, FRAME_CLOCKED, encoder_args
+from stabilize.video.encoders import DEFAULT_PRESET, EDITING_PIX_FMT, FRAME_CLOCKED, encoder_args
 from stabilize.video.i420 import pipe_format, pipe_layout
 
 
@@ -46,11 +46,14 @@ class Encoding:
     def for_frames(self, container: Container, pix_fmt_in: str) -> Encoding:
         """This encoding made whole for frames piped as ``pix_fmt_in`` into ``container``.
 
-        A 10-bit pipe (``yuv420p10le``) is encoded at 10 bits, by the container's encoder
-        for deep sources where none is asked for: HEVC in MP4, MOV, MKV and TS, since
-        H.264 at 10 bits plays neither on Apple's devices nor in most browsers. An image
-        sequence's pictures take their format's pixels (16 bits a channel in PNG and
-        TIFF for a deep source).
+        A 10-bit pipe (``yuv420p10le``, or 16-bit RGB, ``rgb48le``) is encoded at 10
+        bits, by the container's encoder for deep sources where none is asked for: HEVC
+        in MP4, MOV, MKV and TS, since H.264 at 10 bits plays neither on Apple's devices
+        nor in most browsers. Frames are written as 4:2:0, which every player plays,
+        unless a pixel format is asked for or the encoder is an editing codec, which
+        writes its own 4:2:2 (:data:`~stabilize.video.encoders.EDITING_PIX_FMT`). An
+        image sequence's pictures take their format's pixels (16 bits a channel in PNG
+        and TIFF for a deep source).
 
         >>> from stabilize.video.containers import container_for
         >>> deep = Encoding().for_frames(container_for("a.mov"), "yuv420p10le")
@@ -60,19 +63,24 @@ class Encoding:
         'libx264'
         >>> Encoding(codec="libx264").for_frames(container_for("a.mov"), "yuv420p10le").codec
         'libx264'
+        >>> Encoding().for_frames(container_for("a.mkv"), "rgb48le").pix_fmt
+        'yuv420p10le'
+        >>> Encoding(codec="prores_ks").for_frames(container_for("a.mov"), "rgb24").pix_fmt
+        'yuv422p10le'
         >>> Encoding().for_frames(container_for("f/%05d.png"), "yuv420p10le").pix_fmt
         'rgb48be'
         """
-        deep = pix_fmt_in == "yuv420p10le"
+        deep = pipe_format(pix_fmt_in) != "yuv420p"  # 10 bits or more
         if container.pix_fmt:  # the encoder's own (GIF's palette)
             return replace(self, codec=self.codec_for(container), pix_fmt=container.pix_fmt)
         if container.pictures:  # an image sequence's: RGB, or JPEG's full-range YUV
             return replace(self, codec=self.codec_for(container), pix_fmt=container.pictures[deep])
-        if not deep:
-            return replace(self, codec=self.codec_for(container))
-        codec = self.codec or container.deep_encoder or container.video_encoder
-        pix_fmt = pix_fmt_in if self.pix_fmt == "yuv420p" else self.pix_fmt
-        return replace(self, codec=codec, pix_fmt=pix_fmt)
+        codec = self.codec or (container.deep_encoder if deep else None) or container.video_encoder
+        if self.pix_fmt != "yuv420p":  # asked for
+            return replace(self, codec=codec)
+        if codec in EDITING_PIX_FMT:
+            return replace(self, codec=codec, pix_fmt=EDITING_PIX_FMT[codec][deep])
+        return replace(self, codec=codec, pix_fmt=pipe_format(pix_fmt_in))
 
 
 @dataclass(frozen=True)
@@ -127,8 +135,9 @@ def _filters(delay: float, chain: str, fine: bool = True) -> list[str]:
 
 
 class FrameWriter:
-    """Streams RGB uint8 frames (or I420, with ``pix_fmt_in="yuv420p"``) into an encoder
-    process at a constant frame rate ``fps``, muxed with what ``mux`` adds, tagged with the
+    """Streams RGB uint8 frames (uint16 with ``pix_fmt_in="rgb48le"``, or I420 with
+    ``"yuv420p"`` or ``"yuv420p10le"``) into an encoder process at a constant frame rate
+    ``fps``, muxed with what ``mux`` adds, tagged with the
     source's ``colour`` (I420 frames are taken to be in it already; RGB ones are
     converted to it)."""
 

@@ -105,6 +105,17 @@ PROFILES: dict[str, tuple[list[str], list[str]]] = {
 }
 
 
+# The editing codecs' own pixels (4:2:2, as their profiles above store it) at either
+# depth. Given the pipe's 4:2:0, FFmpeg converted to these anyway, after the pipe had
+# halved the colour of a 4:2:2 source; named, they let that colour travel whole
+# (:func:`stabilize.warp.render.piped_format`)
+EDITING_PIX_FMT: dict[str, tuple[str, str]] = {
+    "dnxhd": ("yuv422p", "yuv422p10le"),
+    "prores_ks": ("yuv422p10le", "yuv422p10le"),
+    "prores_aw": ("yuv422p10le", "yuv422p10le"),
+}
+
+
 def encoder_args(codec: str, crf: int | None, preset: str, deep: bool = False) -> list[str]:
     """FFmpeg's arguments for ``codec`` at quality ``crf`` (None: the codec's default),
     for frames of 10 bits or more where ``deep``.

@@ -6,6 +6,11 @@ on either side, half as many bytes cross the pipes, and a warp touches 1.5 bytes
 pixel instead of 3. A frame is one (3H/2, W) uint8 array: the luma plane (H, W), then the
 two chroma planes (H/2, W/2) one after the other. Both sides must be even.
 
+A source whose colour is finer than 4:2:0 (a camera's or ProRes's 4:2:2, 4:4:4, RGB
+pictures), bound for an encoder that keeps colour that fine, travels as RGB instead
+(:func:`rgb_pipe`), as does a frame with an odd side: 4:2:0 would halve its colour on
+the way.
+
 This module knows the layout only; warping the planes is :mod:`stabilize.warp.planes`.
 """
 
@@ -37,6 +42,16 @@ def pipe_format(source_pix_fmt: str) -> str:
     """
     depth = re.search(r"(\d+)(?:le|be)$", source_pix_fmt)
     return "yuv420p10le" if depth and int(depth.group(1)) >= 10 else "yuv420p"
+
+
+def rgb_pipe(source_pix_fmt: str) -> str:
+    """The RGB pipe format that keeps a source's depth: 16 bits a channel for a source of
+    10 bits or more, else 8.
+
+    >>> [rgb_pipe(f) for f in ("yuv422p", "rgb24", "yuv422p10le", "gbrp16le")]
+    ['rgb24', 'rgb24', 'rgb48le', 'rgb48le']
+    """
+    return "rgb24" if pipe_format(source_pix_fmt) == "yuv420p" else "rgb48le"
 
 
 def has_alpha(pix_fmt: str) -> bool:
@@ -77,13 +92,29 @@ def chroma(pix_fmt: str) -> str | None:
     return next((j for j, names in _PACKED_CHROMA.items() if pix_fmt.startswith(names)), None)
 
 
+# The share of the luma's samples each chroma plane keeps, by subsampling
+CHROMA_SHARE = {"4:4:4": 1.0, "4:2:2": 0.5, "4:4:0": 0.5, "4:2:0": 0.25, "4:1:1": 0.25}
+
+
+def finer(pix_fmt: str, than: str) -> bool:
+    """Whether FFmpeg's ``pix_fmt`` keeps colour finer than ``than`` does (grey, or a
+    format of unknown subsampling, keeps none).
+
+    >>> finer("yuv422p10le", "yuv420p"), finer("rgb24", "yuv422p"), finer("gray", "yuv420p")
+    (True, True, False)
+    """
+    return CHROMA_SHARE.get(chroma(pix_fmt) or "", 0.0) > CHROMA_SHARE.get(chroma(than) or "", 0.0)
+
+
 def pipe_layout(pix_fmt: str, size: tuple[int, int]) -> tuple[tuple[int, ...], type]:
     """(shape, dtype) of one raw frame of (H, W) pixels in FFmpeg's ``pix_fmt``: I420
-    (3H/2, W), 8 or 10 bits (``yuv420p10le``: uint16), else RGB (H, W, 3) uint8."""
+    (3H/2, W), 8 or 10 bits (``yuv420p10le``: uint16), else RGB (H, W, 3), 8 or 16 bits
+    (``rgb48le``: uint16)."""
     h, w = size
+    deep = np.uint16 if pix_fmt.endswith("le") else np.uint8
     if pix_fmt.startswith("yuv420p"):
-        return (h * 3 // 2, w), np.uint16 if pix_fmt.endswith("10le") else np.uint8
-    return (h, w, 3), np.uint8
+        return (h * 3 // 2, w), deep
+    return (h, w, 3), deep
 
 
 def supports(size: tuple[int, int]) -> bool:

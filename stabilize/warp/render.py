@@ -1,7 +1,8 @@
 """Pass 2: decode at full size, warp each frame along the planned path, encode.
 
 Pass 2 stays in I420 from decoder to encoder where the sizes allow (both sides even):
-no colour conversion on either side, and half the bytes through the pipes. A clip
+no colour conversion on either side, and half the bytes through the pipes. Colour finer
+than 4:2:0, bound for an encoder that keeps it, travels as RGB (:func:`piped_format`). A clip
 decoded as its sensor stored it (:meth:`stabilize.video.VideoInfo.stored`) is turned to
 be shown once warped: the output is written upright, with no display rotation.
 """
@@ -60,8 +61,8 @@ def render(
     variable = container.timed and is_variable_rate(times)
     if len(times) < len(planned.times) and not variable:  # every k-th frame
         fps = (len(times) - 1) / (times[-1] - times[0])
-    pix_fmt = piped_format(info, settings)
-    planar = pix_fmt != "rgb24"
+    pix_fmt = piped_format(info, settings, container)
+    planar = pix_fmt.startswith("yuv")
     encoding = replace(encoding, b_frames=False) if variable else encoding
     target = out.with_name(f"{out.stem}.cfr{out.suffix}") if variable else out
     side_by_side = i420.hstack if planar else lambda a, b: np.hstack([a, b])
@@ -176,18 +177,25 @@ def shown_notice(times: NDArray, container: Container) -> tuple[str, ...]:
     )
 
 
-def piped_format(info: VideoInfo, settings: Settings) -> str:
-    """FFmpeg's format of the frames piped to the encoder: I420 at the source's depth (8
-    or 10 bits) where the frames' sizes allow, so there are no colour conversions and
-    half the bytes travel; else RGB."""
-    planar = i420.supports(info.size) and i420.supports(frame_size(info, settings))
-    return i420.pipe_format(info.pix_fmt) if planar else "rgb24"
+def piped_format(info: VideoInfo, settings: Settings, container: Container) -> str:
+    """FFmpeg's format of the frames piped to the encoder into ``container``: I420 at the
+    source's depth (8 or 10 bits), so there are no colour conversions and half the bytes
+    travel; else RGB at its depth (8 or 16 bits a channel), where a side is odd, or where
+    the source's colour is finer than 4:2:0 (a camera's or ProRes's 4:2:2, 4:4:4, RGB
+    pictures) and the encoder keeps colour that fine (ProRes, DNxHR, PNG or TIFF
+    pictures, a GIF's palette): I420 would halve it on the way."""
+    planar, rgb = i420.pipe_format(info.pix_fmt), i420.rgb_pipe(info.pix_fmt)
+    if not (i420.supports(info.size) and i420.supports(frame_size(info, settings))):
+        return rgb
+    written = settings.encoding.for_frames(container, planar).pix_fmt
+    fine = i420.finer(info.pix_fmt, planar) and i420.finer(written, planar)
+    return rgb if fine else planar
 
 
 def output_encoding(info: VideoInfo, settings: Settings, container: Container) -> Encoding:
     """The encoder and pixel format the output is written with: ``--codec``, else the
     container's default for the source's depth (:meth:`Encoding.for_frames`)."""
-    return settings.encoding.for_frames(container, piped_format(info, settings))
+    return settings.encoding.for_frames(container, piped_format(info, settings, container))
 
 
 def encoded_size(info: VideoInfo, settings: Settings) -> tuple[int, int]:

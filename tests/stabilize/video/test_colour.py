@@ -136,19 +136,6 @@ def test_a_deep_source_written_at_8_bits_is_said(hdr10, tmp_path):
     )
 
 
-def test_a_deep_source_with_an_odd_side_piped_at_8_bits_is_said(shaky, tmp_path):
-    # an odd side sends the frames through 8-bit RGB, whatever the encoder holds
-    clip = tmp_path / "odd.mkv"
-    cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-frames:v", "8", "-vf"]
-    subprocess.run([*cmd, "format=rgb48le,crop=319:179", "-c:v", "ffv1", str(clip)], check=True)
-    summary, _ = stabilize_video(clip, tmp_path / "out.mkv", Settings(fov=70.0))
-    said = [n for n in summary["notices"] if "8 bits" in n]
-    assert said == [
-        "gbrp16le video written at 8 bits: with an odd side, its frames travel to the "
-        "encoder as 8-bit RGB"
-    ]
-
-
 def test_hdr10_metadata_an_encoder_cannot_write_is_said_lost(hdr10, tmp_path):
     summary, _ = stabilize_video(hdr10, tmp_path / "out.webm", Settings(fov=70.0))
     assert any("HDR10's mastering display" in n for n in summary["notices"])
