@@ -160,7 +160,8 @@ def batch(
 
 
 def _jobs(params: dict, settings) -> list:
-    """The folder's jobs, after checking that ``--format``'s container takes the encoder."""
+    """The folder's jobs, after checking that their outputs' containers (``--format``'s, or
+    each input's) take the encoder."""
     from stabilize.batch import find_jobs
     from stabilize.video.preflight import check_encoder
 
@@ -182,6 +183,13 @@ def _jobs(params: dict, settings) -> list:
     )
     if not jobs:
         fail(f"{in_dir}: no files match {pattern!r}" if pattern else f"{in_dir}: no videos")
+    if settings.encoding.codec and not suffix:
+        # each container the outputs are in, as their inputs' suffixes name them: a codec
+        # FFmpeg does not have, or one a container does not take, failed every such clip
+        # in turn, the batch ending in a table of failures
+        for kind in sorted({Path(job.output).suffix.lower() for job in jobs}):
+            every = Path(out_dir) / f"*{kind}"
+            run_or_fail(lambda every=every: check_encoder(every, settings.encoding, (64, 64)))
     return jobs
 
 
