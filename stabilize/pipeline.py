@@ -143,7 +143,7 @@ def stabilize_video(
         tell(damage.notice)
         if lead > 0:
             tell(f"damaged: the first {lead:.2f} s of video do not decode: it starts there")
-        track, focal, rotations = _motion(src, job, settings, bar, tell)
+        track, focal, rotations = _damaged_motion(src, job, settings, bar, tell, damage)
     R, rolling, residual, repaired, gyro_summary, shutter, eased = rotations
     t_estimate = time.perf_counter() - start
     K = _camera_matrix(focal.px, job.info, job.lens)
@@ -403,6 +403,24 @@ def dates_rows(settings: Settings, log: GyroLog | None = None, lens: Lens | None
         readout, _ = starting_readout(settings.readout_ms, from_log, lens and lens.readout_s)
         return readout is None or (settings.gyro_fallback and visual)
     return visual
+
+
+def _damaged_motion(src: Path, job: Job, settings: Settings, bar, tell, damage: Damaged) -> tuple:
+    """:func:`_motion` on a damaged clip's frames that decode; a gyro log they do not
+    match is refused naming the damage, which no option of the log's cures."""
+    from stabilize.gyro.log import GyroError
+
+    try:
+        return _motion(src, job, settings, bar, tell)
+    except GyroError as err:
+        # the frames decoded after a gap, from missing references, turn as garbage: the
+        # rendered sample, damaged, read 2-6 degrees a frame there against 0.7
+        lost = damage.listed - damage.decoded
+        raise GyroError(
+            f"{err} (the video is damaged: {lost} of its {damage.listed} frames do not "
+            "decode, and those after them decode wrongly, which the match cannot see past; "
+            "without --gyro it is stabilised from its own motion)"
+        ) from None
 
 
 def _motion(src: Path, job: Job, settings: Settings, bar, tell) -> tuple:

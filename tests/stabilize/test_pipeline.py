@@ -13,12 +13,13 @@ import pytest
 
 from rotation import so3
 from stabilize import Settings, stabilize_video
+from stabilize.gyro.log import GyroError
 from stabilize.motion.focal import initial_focal
 from stabilize.pipeline import prepare
 from stabilize.synth import SynthOptions, trajectory
 from stabilize.video import Encoding, ffmpeg_exe, frame_times, probe, read_frames
 from tests.stabilize.conftest import render
-from tests.stabilize.helpers import boxed, combing, damaged, held_upright, squeezed, woven
+from tests.stabilize.helpers import SAMPLE, boxed, combing, damaged, held_upright, squeezed, woven
 
 
 @pytest.fixture(scope="module")
@@ -342,6 +343,16 @@ def test_a_damaged_clip_is_stabilised_from_the_frames_that_decode(shaky, tmp_pat
     assert summary["frames"] == len(decoded) and probe(out).has_audio
     np.testing.assert_allclose(frame_times(out), decoded, atol=1e-3)  # each at its own time
     assert any(line.startswith("damaged: ") for line in heard)
+
+
+def test_a_gyro_log_a_damaged_clip_cannot_match_is_refused_naming_the_damage(tmp_path):
+    # the frames decoded after the gap turn as garbage: the refusal advised checking the
+    # log, and giving its offset and axes, which fail the same check
+    ts = damaged(SAMPLE / "clip.mp4", tmp_path)
+    settings = Settings(fov=70.0, gyro=str(SAMPLE / "gyro.csv"))
+    damage = r"the video is damaged: \d+ of its \d+ frames do not decode"
+    with pytest.raises(GyroError, match=damage):
+        stabilize_video(ts, tmp_path / "out.mp4", settings)
 
 
 def test_a_clip_damaged_at_its_start_keeps_its_video_in_sync(shaky, tmp_path):
