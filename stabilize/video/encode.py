@@ -137,9 +137,8 @@ def _filters(delay: float, chain: str, fine: bool = True) -> list[str]:
 class FrameWriter:
     """Streams RGB uint8 frames (uint16 with ``pix_fmt_in="rgb48le"``, or I420 with
     ``"yuv420p"`` or ``"yuv420p10le"``) into an encoder process at a constant frame rate
-    ``fps``, muxed with what ``mux`` adds, tagged with the
-    source's ``colour`` (I420 frames are taken to be in it already; RGB ones are
-    converted to it)."""
+    ``fps``, muxed with what ``mux`` adds, tagged with the source's ``colour`` (I420
+    frames are taken to be in it already; RGB ones are converted to it)."""
 
     def __init__(
         self,

@@ -111,7 +111,7 @@ def pipe_layout(pix_fmt: str, size: tuple[int, int]) -> tuple[tuple[int, ...], t
     (3H/2, W), 8 or 10 bits (``yuv420p10le``: uint16), else RGB (H, W, 3), 8 or 16 bits
     (``rgb48le``: uint16)."""
     h, w = size
-    deep = np.uint16 if pix_fmt.endswith("le") else np.uint8
+    deep = np.uint16 if pipe_format(pix_fmt) != "yuv420p" else np.uint8
     if pix_fmt.startswith("yuv420p"):
         return (h * 3 // 2, w), deep
     return (h, w, 3), deep

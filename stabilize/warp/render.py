@@ -2,8 +2,8 @@
 
 Pass 2 stays in I420 from decoder to encoder where the sizes allow (both sides even):
 no colour conversion on either side, and half the bytes through the pipes. Colour finer
-than 4:2:0, bound for an encoder that keeps it, travels as RGB (:func:`piped_format`). A clip
-decoded as its sensor stored it (:meth:`stabilize.video.VideoInfo.stored`) is turned to
+than 4:2:0, bound for an encoder that keeps it, travels as RGB (:func:`piped_format`).
+A clip decoded as its sensor stored it (:meth:`stabilize.video.VideoInfo.stored`) is turned to
 be shown once warped: the output is written upright, with no display rotation.
 """
 
