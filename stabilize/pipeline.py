@@ -55,6 +55,7 @@ from stabilize.video.fields import DEINTERLACE_MODES, field_times
 from stabilize.video.i420 import chroma, finer, pipe_format
 from stabilize.video.preflight import (
     check_encoder,
+    check_pix_fmt,
     check_streams,
     check_times,
     check_writable,
@@ -214,6 +215,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     check_writable(dst)
     container = container_for(dst)
     encoding = output_encoding(info, settings, container)
+    check_pix_fmt(encoding)
     check_encoder(dst, encoding, encoded_size(info, settings), info.fps or 30.0)
     lens = read_lens_profile(settings.lens, info.size) if settings.lens else None
     times = frame_times(src, info.input_args)  # read once: the packets, not the pixels
@@ -243,7 +245,7 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
     notices += encoder_notice(encoding, settings.encoding.codec_for(container))
     notices += unused_options(encoding.codec, encoding.crf, encoding.preset)
     notices += shown_notice(times, container)
-    notices += pipe_notices(info, encoding)
+    notices += pipe_notices(info, encoding, asked=settings.encoding.pix_fmt is not None)
     if not settings.size and frame_size(info, settings) != info.shown_framed_size:
         (h, w), (sh, sw) = frame_size(info, settings), info.shown_framed_size
         notices += (
@@ -265,11 +267,12 @@ def encoder_notice(encoding: Encoding, default: str) -> tuple[str, ...]:
     )
 
 
-def pipe_notices(info: VideoInfo, encoding: Encoding) -> tuple[str, ...]:
+def pipe_notices(info: VideoInfo, encoding: Encoding, asked: bool = False) -> tuple[str, ...]:
     """Notices for what of the source's picture does not reach the output: what cannot
     travel through the pipe to the encoder (Dolby Vision's and HDR10+'s metadata, closed
-    captions, alpha), or what the ``encoding`` cannot write (colour as fine, depth,
-    HDR10's static metadata)."""
+    captions, alpha), or what the ``encoding`` does not write (colour as fine, depth:
+    where its pixel format was ``asked`` for, --pix-fmt is named as the cause; HDR10's
+    static metadata)."""
     notices = dolby_vision_notice(info.colour.dolby_vision)
     if info.colour.hdr10_plus:
         notices += (
@@ -287,13 +290,13 @@ def pipe_notices(info: VideoInfo, encoding: Encoding) -> tuple[str, ...]:
             f"the source's alpha (transparency, {info.pix_fmt}) is left out: the frames "
             "are stabilised and written without it",
         )
-    notices += chroma_notice(info.pix_fmt, encoding)
+    notices += chroma_notice(info.pix_fmt, encoding, asked)
     deep = pipe_format(info.pix_fmt) != "yuv420p"  # a source of 10 bits or more
     if deep and pipe_format(encoding.pix_fmt) == "yuv420p":
-        notices += (
-            f"{info.pix_fmt} video written at 8 bits: {encoding.codec} "
-            f"({encoding.pix_fmt}) holds no more",
+        why = (
+            "as --pix-fmt asks" if asked else f"{encoding.codec} ({encoding.pix_fmt}) holds no more"
         )
+        notices += (f"{info.pix_fmt} video written at 8 bits: {why}",)
     if info.colour.hdr10_lost(encoding.codec):
         notices += (
             f"HDR10's mastering display and light levels left out: {encoding.codec} does "
@@ -302,19 +305,22 @@ def pipe_notices(info: VideoInfo, encoding: Encoding) -> tuple[str, ...]:
     return notices
 
 
-def chroma_notice(source: str, encoding: Encoding) -> tuple[str, ...]:
+def chroma_notice(source: str, encoding: Encoding, asked: bool = False) -> tuple[str, ...]:
     """A notice where the source's colour is finer than the ``encoding`` writes it: a
     camera's or ProRes's 4:2:2, 4:4:4 or RGB pictures written as 4:2:0, which every
-    player plays. (It travels whole to an encoder that keeps it:
-    :func:`stabilize.warp.render.piped_format`.)"""
+    player plays, unless a pixel format is ``asked`` for. (It travels whole to an encoder
+    that keeps it: :func:`stabilize.warp.render.piped_format`.)"""
     written = encoding.pix_fmt
     if not finer(source, written):
         return ()
-    return (
-        f"the source's {chroma(source)} colour ({source}) is written as {chroma(written)} "
-        f"({written}), as {encoding.codec} writes it here; ProRes, DNxHR (--codec "
-        "prores_ks, dnxhd), PNG and TIFF keep finer colour",
+    why = (
+        "as --pix-fmt asks"
+        if asked
+        else f"as {encoding.codec} writes it here; ProRes, DNxHR (--codec prores_ks, dnxhd), "
+        "PNG, TIFF and --pix-fmt keep finer colour"
     )
+    said = f"the source's {chroma(source)} colour ({source}) is written as {chroma(written)}"
+    return (f"{said} ({written}), {why}",)
 
 
 def dolby_vision_notice(profile: str | None) -> tuple[str, ...]:

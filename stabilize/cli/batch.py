@@ -32,6 +32,7 @@ from stabilize.cli.options import (
     MaxZoomOption,
     MethodOption,
     MotionOption,
+    PixFmtOption,
     PresetOption,
     PreviewOption,
     QuietOption,
@@ -101,6 +102,7 @@ def batch(
     codec: CodecOption = ENCODING.codec,
     crf: CrfOption = ENCODING.crf,
     preset: PresetOption = ENCODING.preset,
+    pix_fmt: PixFmtOption = ENCODING.pix_fmt,
     preview: PreviewOption = NO_PREVIEW,
     size: SizeOption = None,
     deinterlace: DeinterlaceOption = DEFAULTS.deinterlace,
@@ -161,9 +163,10 @@ def batch(
 
 def _jobs(params: dict, settings) -> list:
     """The folder's jobs, after checking that their outputs' containers (``--format``'s, or
-    each input's) take the encoder."""
+    each input's) take the encoder, and that it writes the pixel format asked for."""
     from stabilize.batch import find_jobs
-    from stabilize.video.preflight import check_encoder
+    from stabilize.video.containers import container_for
+    from stabilize.video.preflight import check_encoder, check_pix_fmt
 
     fmt, pattern = params["output_format"], params["pattern"]
     suffix = (fmt if fmt.startswith(".") else f".{fmt}") if fmt else None
@@ -183,13 +186,17 @@ def _jobs(params: dict, settings) -> list:
     )
     if not jobs:
         fail(f"{in_dir}: no files match {pattern!r}" if pattern else f"{in_dir}: no videos")
-    if settings.encoding.codec and not suffix:
+    asked = settings.encoding
+    if asked.codec or asked.pix_fmt:
         # each container the outputs are in, as their inputs' suffixes name them: a codec
         # FFmpeg does not have, or one a container does not take, failed every such clip
         # in turn, the batch ending in a table of failures
         for kind in sorted({Path(job.output).suffix.lower() for job in jobs}):
             every = Path(out_dir) / f"*{kind}"
-            run_or_fail(lambda every=every: check_encoder(every, settings.encoding, (64, 64)))
+            written = asked.for_frames(container_for(every), "yuv420p")
+            run_or_fail(lambda written=written: check_pix_fmt(written))
+            if not suffix:  # (--format's was checked above)
+                run_or_fail(lambda every=every: check_encoder(every, asked, (64, 64)))
     return jobs
 
 

@@ -112,6 +112,15 @@ CrfOption = Annotated[
     ),
 ]
 PresetOption = Annotated[str, typer.Option(help="Encoder speed preset (x264's names).")]
+PixFmtOption = Annotated[
+    str | None,
+    typer.Option(
+        help="Pixel format written, FFmpeg's name (yuv422p10le, yuv444p, …; one the encoder "
+        "writes). Default: 4:2:0 at the source's depth, which every player plays; ProRes's "
+        "and DNxHR's own 4:2:2; a picture format's own. Colour finer than 4:2:0 reaches it "
+        "whole."
+    ),
+]
 DeinterlaceOption = Annotated[
     Literal[DEINTERLACE_MODES],
     typer.Option(
@@ -239,7 +248,12 @@ def job_settings(params: Mapping[str, Any]) -> Settings:
         size=output_size(params["size"]),
         deinterlace=params.get("deinterlace", DEFAULTS.deinterlace),
         bars=params.get("bars", DEFAULTS.bars),
-        encoding=Encoding(codec=params["codec"], crf=params["crf"], preset=params["preset"]),
+        encoding=Encoding(
+            codec=params["codec"],
+            crf=params["crf"],
+            preset=params["preset"],
+            pix_fmt=params.get("pix_fmt"),
+        ),
         gyro=str(gyro) if gyro and str(gyro) != "auto" else None,  # auto: the command's
         gyro_lpf=params["gyro_lpf"],
         readout_ms=readout(params["readout_ms"], gyro, shutter),

@@ -40,6 +40,7 @@ from stabilize.cli.options import (
     MethodOption,
     MotionOption,
     OverwriteOption,
+    PixFmtOption,
     PresetOption,
     PreviewOption,
     QuietOption,
@@ -108,6 +109,7 @@ def run(
     codec: CodecOption = ENCODING.codec,
     crf: CrfOption = ENCODING.crf,
     preset: PresetOption = ENCODING.preset,
+    pix_fmt: PixFmtOption = ENCODING.pix_fmt,
     report: Path | None = typer.Option(
         None, help="Write rotations.csv, path.csv, trajectory.png and summary.json here."
     ),

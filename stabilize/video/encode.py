@@ -35,7 +35,9 @@ class Encoding:
     codec: str | None = None
     crf: int | None = None
     preset: str = DEFAULT_PRESET
-    pix_fmt: str = "yuv420p"
+    # what is written (FFmpeg's name); None: chosen by :meth:`for_frames`, 4:2:0 at the
+    # source's depth, which every player plays
+    pix_fmt: str | None = None
     threads: int = 0  # encoder threads; 0 lets the encoder choose (all cores)
     b_frames: bool = True  # off for variable-frame-rate output, whose packets are retimed
 
@@ -69,14 +71,20 @@ class Encoding:
         'yuv422p10le'
         >>> Encoding().for_frames(container_for("f/%05d.png"), "yuv420p10le").pix_fmt
         'rgb48be'
+        >>> asked = Encoding(pix_fmt="yuv422p10le").for_frames(container_for("a.mov"), "yuv420p")
+        >>> asked.codec, asked.pix_fmt
+        ('libx265', 'yuv422p10le')
         """
         deep = pipe_format(pix_fmt_in) != "yuv420p"  # 10 bits or more
         if container.pix_fmt:  # the encoder's own (GIF's palette)
             return replace(self, codec=self.codec_for(container), pix_fmt=container.pix_fmt)
+        if self.pix_fmt is not None:  # asked for (--pix-fmt)
+            deep = deep or pipe_format(self.pix_fmt) != "yuv420p"
         if container.pictures:  # an image sequence's: RGB, or JPEG's full-range YUV
-            return replace(self, codec=self.codec_for(container), pix_fmt=container.pictures[deep])
+            pix_fmt = self.pix_fmt or container.pictures[deep]
+            return replace(self, codec=self.codec_for(container), pix_fmt=pix_fmt)
         codec = self.codec or (container.deep_encoder if deep else None) or container.video_encoder
-        if self.pix_fmt != "yuv420p":  # asked for
+        if self.pix_fmt is not None:
             return replace(self, codec=codec)
         if codec in EDITING_PIX_FMT:
             return replace(self, codec=codec, pix_fmt=EDITING_PIX_FMT[codec][deep])
@@ -102,8 +110,9 @@ def output_args(
     video started ``delay`` s late (:attr:`Mux.video_delay`)."""
     container = container or container_for(path)
     codec = encoding.codec_for(container)
-    deep = pipe_format(encoding.pix_fmt) != "yuv420p"  # 10 bits or more
-    args = [*encoder_args(codec, encoding.crf, encoding.preset, deep), "-pix_fmt", encoding.pix_fmt]
+    pix_fmt = encoding.pix_fmt or "yuv420p"
+    deep = pipe_format(pix_fmt) != "yuv420p"  # 10 bits or more
+    args = [*encoder_args(codec, encoding.crf, encoding.preset, deep), "-pix_fmt", pix_fmt]
     if encoding.threads:
         args += ["-threads", str(encoding.threads)]
     if not encoding.b_frames:

@@ -5,7 +5,9 @@ the options? A mistake found here costs a fraction of a second, not a whole pass
 from __future__ import annotations
 
 import errno
+import functools
 import os
+import re
 import subprocess
 import tempfile
 from dataclasses import replace
@@ -71,6 +73,28 @@ def check_encoder(
         raise OutputError(
             _cannot_write(Path(path), encoding, result.stderr, result.returncode, fps)
         )
+
+
+def check_pix_fmt(encoding: Encoding) -> None:
+    """That the encoder writes the pixel format asked for (``--pix-fmt``), as FFmpeg lists
+    its formats: given another, FFmpeg picks one it writes and says so only in a warning
+    (libx264 asked for yuv410p wrote yuv420p)."""
+    codec, pix_fmt = encoding.codec or "libx264", encoding.pix_fmt
+    written = encoder_pix_fmts(codec)
+    if pix_fmt is None or not written or pix_fmt in written:
+        return
+    raise OutputError(
+        f"--pix-fmt {pix_fmt}: {codec} does not write it; it writes {', '.join(written)}"
+    )
+
+
+@functools.lru_cache(maxsize=32)
+def encoder_pix_fmts(codec: str) -> tuple[str, ...]:
+    """The pixel formats FFmpeg lists for an encoder (none where it lists none)."""
+    cmd = [ffmpeg_exe(), "-hide_banner", "-h", f"encoder={codec}"]
+    said = subprocess.run(cmd, capture_output=True, text=True, errors="replace").stdout
+    listed = re.search(r"Supported pixel formats:(.*)", said)
+    return tuple(listed.group(1).split()) if listed else ()
 
 
 # FFmpeg's words where the suffix names no muxer, and where its muxer holds no video

@@ -329,8 +329,8 @@ def test_colour_finer_than_the_output_writes_is_said(shaky, tmp_path, pix_fmt, h
     summary, _ = stabilize_video(clip, tmp_path / "out.mp4", Settings(fov=70.0))
     said = [n for n in summary["notices"] if "colour" in n]
     assert said == ([f"the source's 4:2:2 colour ({pix_fmt}) is written as 4:2:0 (yuv420p), as "
-                     "libx264 writes it here; ProRes, DNxHR (--codec prores_ks, dnxhd), PNG "
-                     "and TIFF keep finer colour"] if halved else [])  # fmt: skip
+                     "libx264 writes it here; ProRes, DNxHR (--codec prores_ks, dnxhd), PNG, "
+                     "TIFF and --pix-fmt keep finer colour"] if halved else [])  # fmt: skip
 
 
 def test_a_damaged_clip_is_stabilised_from_the_frames_that_decode(shaky, tmp_path):

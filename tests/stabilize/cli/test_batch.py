@@ -34,6 +34,7 @@ def test_options_that_would_fail_every_clip_are_refused_before_any(tmp_path):
         "not a Gyroflow lens profile": ["--lens", str(tmp_path / "bad.json")],
         "RAFT weights not found": ["--flow", "raft", "--raft-weights", str(tmp_path / "no.pth")],
         "FFmpeg cannot write libx246 (preset medium) as .mp4": ["--codec", "libx246"],
+        "--pix-fmt yuv410p: libx264 does not write it": ["--pix-fmt", "yuv410p"],
     }
     for message, options in cases.items():
         args = ["batch", str(tmp_path / "in"), str(tmp_path / "out"), *options]

@@ -79,6 +79,9 @@ CASES = {
     "fps zero": Case(("--fps", "0"), 2, source="frames"),
     "max zoom below 1": Case(("--max-zoom", "0.5"), 2),
     "crf 99": Case(("--crf", "99"), 2),
+    # FFmpeg wrote yuv420p instead, saying so only in a warning
+    "pixel format the encoder does not write": Case(("--pix-fmt", "yuv410p"), 2),
+    "no such pixel format": Case(("--pix-fmt", "yuv420"), 2),
     "unknown codec": Case(("--codec", "nope"), 2),
     "unknown preset": Case(("--preset", "nope"), 2),
     "size not WxH": Case(("--size", "big"), 2),

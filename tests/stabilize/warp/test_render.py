@@ -43,6 +43,21 @@ def test_the_pipe_keeps_what_the_encoder_keeps(source, out, codec, piped):
     assert piped_format(info, settings, container_for(out)) == piped
 
 
+@pytest.mark.parametrize(
+    ("source", "asked", "piped"),
+    [
+        ("yuv422p10le", "yuv422p10le", "rgb48le"),
+        ("yuv422p", "yuv420p", "yuv420p"),
+        ("yuv420p", "yuv444p", "yuv420p"),  # no finer colour to keep
+        ("rgb24", "yuv444p", "rgb24"),
+    ],
+)
+def test_the_pipe_keeps_what_a_pixel_format_asked_for_keeps(source, asked, piped):
+    info = replace(probe(SAMPLE / "clip.mp4"), pix_fmt=source)
+    settings = Settings(encoding=Encoding(pix_fmt=asked))
+    assert piped_format(info, settings, container_for("out.mkv")) == piped
+
+
 def test_an_odd_side_pipes_rgb_at_the_sources_depth():
     info = replace(probe(SAMPLE / "clip.mp4"), pix_fmt="yuv420p10le", width=319)
     assert piped_format(info, Settings(), container_for("out.mkv")) == "rgb48le"
@@ -78,12 +93,17 @@ def _planes(path: Path, pix_fmt: str) -> np.ndarray:
     return np.frombuffer(raw.stdout, np.uint16 if pix_fmt.endswith("le") else np.uint8)
 
 
-def test_a_4_2_2_source_keeps_its_colour_into_prores(tmp_path):
+@pytest.mark.parametrize(
+    "encoding",
+    [Encoding(codec="prores_ks"), Encoding(codec="libx264", crf=0, pix_fmt="yuv422p10le")],
+    ids=["prores", "pix-fmt"],
+)
+def test_a_4_2_2_source_keeps_its_colour(tmp_path, encoding):
     # ProRes 422 in, ProRes 422 out: the frames travelled as 4:2:0, which halved the
-    # colour's rows (a notice said so)
+    # colour's rows (a notice said so); H.264 4:2:2 could not be asked for
     clip = _still_clip(tmp_path, "yuv422p10le", "prores_ks", ".mov")
     out = tmp_path / "out.mov"
-    summary, _ = stabilize_video(clip, out, replace(STILL, encoding=Encoding(codec="prores_ks")))
+    summary, _ = stabilize_video(clip, out, replace(STILL, encoding=encoding))
     assert not any("colour" in n for n in summary["notices"])
     assert probe(out).pix_fmt == "yuv422p10le"
     h, w = probe(clip).size
