@@ -74,12 +74,14 @@ class Encoding:
         >>> asked = Encoding(pix_fmt="yuv422p10le").for_frames(container_for("a.mov"), "yuv420p")
         >>> asked.codec, asked.pix_fmt
         ('libx265', 'yuv422p10le')
+        >>> Encoding(pix_fmt="yuv420p").for_frames(container_for("a.mov"), "yuv420p10le").codec
+        'libx264'
         """
         deep = pipe_format(pix_fmt_in) != "yuv420p"  # 10 bits or more
         if container.pix_fmt:  # the encoder's own (GIF's palette)
             return replace(self, codec=self.codec_for(container), pix_fmt=container.pix_fmt)
-        if self.pix_fmt is not None:  # asked for (--pix-fmt)
-            deep = deep or pipe_format(self.pix_fmt) != "yuv420p"
+        if self.pix_fmt is not None:  # asked for (--pix-fmt): its depth, not the source's
+            deep = pipe_format(self.pix_fmt) != "yuv420p"
         if container.pictures:  # an image sequence's: RGB, or JPEG's full-range YUV
             pix_fmt = self.pix_fmt or container.pictures[deep]
             return replace(self, codec=self.codec_for(container), pix_fmt=pix_fmt)
