@@ -19,7 +19,7 @@ from stabilize.video.binary import drain, ffmpeg_exe, local, widen_pipe
 from stabilize.video.colour import UNKNOWN, Colour
 from stabilize.video.containers import Container, container_for
 from stabilize.video.encoders import DEFAULT_PRESET, EDITING_PIX_FMT, FRAME_CLOCKED, encoder_args
-from stabilize.video.i420 import pipe_format, pipe_layout
+from stabilize.video.i420 import chroma, pipe_format, pipe_layout
 
 
 class EncodeError(RuntimeError):
@@ -114,7 +114,8 @@ def output_args(
     codec = encoding.codec_for(container)
     pix_fmt = encoding.pix_fmt or "yuv420p"
     deep = pipe_format(pix_fmt) != "yuv420p"  # 10 bits or more
-    args = [*encoder_args(codec, encoding.crf, encoding.preset, deep), "-pix_fmt", pix_fmt]
+    full = chroma(pix_fmt) == "4:4:4"
+    args = [*encoder_args(codec, encoding.crf, encoding.preset, deep, full), "-pix_fmt", pix_fmt]
     if encoding.threads:
         args += ["-threads", str(encoding.threads)]
     if not encoding.b_frames:

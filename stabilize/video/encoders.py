@@ -105,6 +105,16 @@ PROFILES: dict[str, tuple[list[str], list[str]]] = {
 }
 
 
+# Their profiles for colour at full resolution (4:4:4, asked for with --pix-fmt): ProRes
+# 4444 and DNxHR 444. The 422 profiles took 4:4:4 pixels silently, ProRes writing a 422
+# HQ file of them (apch), DNxHR refusing ("pixel format is incompatible")
+FULL_CHROMA_PROFILES: dict[str, list[str]] = {
+    "dnxhd": ["-profile:v", "dnxhr_444"],
+    "prores_ks": ["-profile:v", "4"],
+    "prores_aw": ["-profile:v", "4"],
+}
+
+
 # The editing codecs' own pixels (4:2:2, as their profiles above store it) at either
 # depth. Given the pipe's 4:2:0, FFmpeg converted to these anyway, after the pipe had
 # halved the colour of a 4:2:2 source; named, they let that colour travel whole
@@ -116,15 +126,20 @@ EDITING_PIX_FMT: dict[str, tuple[str, str]] = {
 }
 
 
-def encoder_args(codec: str, crf: int | None, preset: str, deep: bool = False) -> list[str]:
+def encoder_args(
+    codec: str, crf: int | None, preset: str, deep: bool = False, full_chroma: bool = False
+) -> list[str]:
     """FFmpeg's arguments for ``codec`` at quality ``crf`` (None: the codec's default),
-    for frames of 10 bits or more where ``deep``.
+    for frames of 10 bits or more where ``deep``, of 4:4:4 colour where ``full_chroma``.
 
     >>> encoder_args("dnxhd", 18, "medium", deep=True)
     ['-c:v', 'dnxhd', '-profile:v', 'dnxhr_hqx']
+    >>> encoder_args("prores_ks", 18, "medium", deep=True, full_chroma=True)
+    ['-c:v', 'prores_ks', '-profile:v', '4']
     """
     if codec in PROFILES:
-        return ["-c:v", codec, *PROFILES[codec][deep]]
+        profile = FULL_CHROMA_PROFILES[codec] if full_chroma else PROFILES[codec][deep]
+        return ["-c:v", codec, *profile]
     quality = DEFAULT_CRF.get(codec, 18) if crf is None else crf
     return ["-c:v", codec, *ENCODERS.get(codec, _x26x)(quality, preset)]
 

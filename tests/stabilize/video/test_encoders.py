@@ -1,8 +1,10 @@
 """Each encoder's quality and speed: --crf and --preset on its own scale."""
 
+import av
+import numpy as np
 import pytest
 
-from stabilize.video import Encoding
+from stabilize.video import Encoding, FrameWriter
 from stabilize.video.encoders import encoder_args, unused_options
 from stabilize.video.preflight import check_encoder
 
@@ -61,3 +63,18 @@ def test_editing_codecs_take_any_size_at_either_depth(tmp_path, codec, pix_fmt):
     encoding = Encoding(codec=codec, pix_fmt=pix_fmt)
     check_encoder(tmp_path / "out.mov", encoding, (180, 320))
     check_encoder(tmp_path / "out.mxf", encoding, (180, 320), 25.0)
+
+
+@pytest.mark.parametrize(
+    ("codec", "suffix", "profile"),
+    [("prores_ks", ".mov", "4444"), ("prores_aw", ".mov", "4444"), ("dnxhd", ".mxf", "DNXHR 444")],
+)
+def test_editing_codecs_write_4_4_4_in_their_4_4_4_profile(tmp_path, codec, suffix, profile):
+    # ProRes wrote 4:4:4 pixels as a 422 HQ file (apch), DNxHR refused them
+    out = tmp_path / f"out{suffix}"
+    asked = Encoding(codec=codec, pix_fmt="yuv444p10le")
+    with FrameWriter(out, (180, 320), 25.0, asked) as writer:  # DNxHR: 256x120 at least
+        for _ in range(2):
+            writer.write(np.zeros(writer.shape, writer.dtype))
+    with av.open(str(out)) as written:
+        assert written.streams.video[0].codec_context.profile == profile
