@@ -244,8 +244,12 @@ def prepare(src: Path, dst: Path, settings: Settings, overwrite: bool) -> Job:
             notices += ("an image sequence keeps no frame times (--report's path.csv has them)",)
     notices += encoder_notice(encoding, settings.encoding.codec_for(container))
     notices += unused_options(encoding.codec, encoding.crf, encoding.preset)
+    asked = settings.encoding.pix_fmt
+    if asked not in (None, encoding.pix_fmt):  # a GIF's palette is its pixels
+        name = container.name or container.muxer
+        notices += (f"--pix-fmt {asked} has no effect on {name}: it writes {encoding.pix_fmt}",)
     notices += shown_notice(times, container)
-    notices += pipe_notices(info, encoding, asked=settings.encoding.pix_fmt is not None)
+    notices += pipe_notices(info, encoding, asked=asked is not None)
     if not settings.size and frame_size(info, settings) != info.shown_framed_size:
         (h, w), (sh, sw) = frame_size(info, settings), info.shown_framed_size
         notices += (

@@ -333,6 +333,13 @@ def test_colour_finer_than_the_output_writes_is_said(shaky, tmp_path, pix_fmt, h
                      "TIFF and --pix-fmt keep finer colour"] if halved else [])  # fmt: skip
 
 
+def test_a_pixel_format_a_gif_cannot_take_is_said_to_have_no_effect(shaky, tmp_path):
+    # a GIF's palette is its pixels: --pix-fmt was passed over silently
+    settings = Settings(fov=70.0, encoding=Encoding(pix_fmt="yuv444p"))
+    summary, _ = stabilize_video(shaky, tmp_path / "out.gif", settings)
+    assert "--pix-fmt yuv444p has no effect on GIF: it writes pal8" in summary["notices"]
+
+
 def test_a_damaged_clip_is_stabilised_from_the_frames_that_decode(shaky, tmp_path):
     # it was refused ("truncated or damaged: the container lists 49 frames, only 41 decode")
     ts, out = damaged(shaky, tmp_path), tmp_path / "out.mp4"
