@@ -32,6 +32,7 @@ from rotation import so3
 from rotation.camera import intrinsics
 from rotation.hough import warm_up
 from stabilize.gyro.log import GyroLog
+from stabilize.motion.cuts import cut_pairs
 from stabilize.motion.estimate import READOUT_BANDS, Damaged
 from stabilize.motion.focal import estimate_motion
 from stabilize.motion.repair import repair_unreliable
@@ -476,7 +477,8 @@ def _rotations(
         if samples is not None:
             agreeing = partial(samples.agreeing, focal=focal)
             refined = partial(samples.refined, focal=focal)
-        R, reliable = repair_unreliable(track.rotations, track.support, agreeing, refined)
+        cuts = _cuts(track, tell)
+        R, reliable = repair_unreliable(track.rotations, track.support, agreeing, refined, cuts)
         rolling, summary = None, None
         from stabilize.shutter import readout_for, visual_rolling_shutter
 
@@ -508,6 +510,17 @@ def _rotations(
     if residual is not None:
         residual = np.where(reliable[:, None], residual, 0.0)
     return R, rolling, residual, int((~reliable).sum()), summary, shutter, eased
+
+
+def _cuts(track: VisualTrack, tell: Callable[[str], None]) -> NDArray[np.bool_]:
+    """The track's cuts (changes of shot, :mod:`stabilize.motion.cuts`), said."""
+    if track.likeness is None:
+        return np.zeros(len(track.support), bool)
+    cuts = cut_pairs(track.likeness, track.support)
+    if cuts.any():
+        at = ", ".join(f"{t:.2f} s" for t in track.times[1:][cuts])
+        tell(f"a cut (a change of shot) at {at}: its turn is taken from the frames beside it")
+    return cuts
 
 
 def _gyro_rotations(

@@ -37,6 +37,7 @@ from flow.texture import textured
 from rotation import HoughEstimator
 from rotation.camera import scale_intrinsics
 from rotation.sampling import SampleGrid
+from stabilize.motion.cuts import likeness, thumbnail
 from stabilize.motion.residual import residual_motion
 from stabilize.motion.track import Samples, VisualTrack, mean_rows
 from stabilize.progress import Progress, no_progress
@@ -87,7 +88,8 @@ def estimate_rotations(
     residual: list[NDArray] = []
     masks = band_masks(estimator, ws.size[0], voted)
     textures: deque[NDArray] = deque()  # each frame's measurable vectors, until its pair
-    noted = _noting_texture(frames, estimator.grid, textures)
+    likenesses: list[float] = []  # each pair's (cuts.likeness)
+    noted = _noting_texture(_noting_likeness(frames, likenesses), estimator.grid, textures)
     # A chunk's vote runs while the next chunk's flow is computed: without the overlap,
     # pass 1 used 1.65 of this machine's 2 cores (1080p, 10 s, with the bands' votes
     # below: 7.8 s, 7.0 with it), when the flow kept one core busy; it now takes pairs
@@ -120,7 +122,9 @@ def estimate_rotations(
     if len(times) != n:  # a frame's worth of slack for containers that list one extra
         times = times[:n] if len(times) > n else np.arange(n) / max(info.fps, 1.0)
     samples = _samples(kept, estimator, ws) if kept else None
-    return replace(_track(times, found, voted), samples=samples, residual=np.concatenate(residual))
+    track = _track(times, found, voted)
+    alike = np.array(likenesses[: n - 1])
+    return replace(track, samples=samples, residual=np.concatenate(residual), likeness=alike)
 
 
 class Damaged(VideoError):
@@ -284,6 +288,19 @@ def _noting_texture(
     measure flow at the sample grid (:func:`flow.texture.textured`)."""
     for frame in frames:
         textures.append(textured(frame, grid.rows, grid.cols))
+        yield frame
+
+
+def _noting_likeness(frames: Iterator[NDArray], likenesses: list[float]) -> Iterator[NDArray]:
+    """The frames as they are, noting in ``likenesses`` how alike each looks to the one
+    before (:func:`stabilize.motion.cuts.likeness`: about 0.2 ms a pair, with the
+    thumbnails)."""
+    before = None
+    for frame in frames:
+        small = thumbnail(frame)
+        if before is not None:
+            likenesses.append(likeness(before, small))
+        before = small
         yield frame
 
 

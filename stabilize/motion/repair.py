@@ -56,6 +56,7 @@ def repair_unreliable(
     support: NDArray,
     agreeing: Callable[[int, NDArray], int] | None = None,
     refined: Callable[[int, NDArray], NDArray] | None = None,
+    cuts: NDArray | None = None,
 ) -> tuple[NDArray, NDArray]:
     """Replace the rotations R (N-1, 3, 3) whose ``support`` is too low and that jump
     away from their neighbours', unless ``agreeing(k, R)``, how many of pair k's flow
@@ -64,22 +65,30 @@ def repair_unreliable(
     the neighbours' mean, where more of them agree with it than with the mean; else the
     mean.
 
+    A pair that ``cuts`` marks (a change of shot, :mod:`stabilize.motion.cuts`) is the
+    neighbours' mean whatever its vectors say: they see two unrelated pictures.
+
     Returns (R, reliable mask); all frames count as reliable when none, or all, are
-    short of support.
+    short of support, cuts aside.
     """
     support = np.asarray(support)
+    cuts = np.zeros(len(R), bool) if cuts is None else np.asarray(cuts, bool)
     supported = support >= max(MIN_SUPPORT, RELATIVE_SUPPORT * float(np.median(support)))
-    if supported.all() or not supported.any():
+    weighed = not (supported.all() or not supported.any())  # support tells pairs apart
+    if not (weighed or cuts.any()) or cuts.all():
         return R, np.ones(len(R), bool)
     rotvecs = so3.log_so3(R)
-    good = np.flatnonzero(supported)
+    good = np.flatnonzero((supported if weighed else True) & ~cuts)
     out = rotvecs.copy()
     reliable = np.ones(len(R), bool)  # a frame is unreliable once it is repaired
-    for k in np.flatnonzero(~supported):
+    for k in np.flatnonzero((~supported if weighed else False) | cuts):
         near = good[np.abs(good - k) <= REPAIR_WINDOW]
         if near.size == 0:
             near = good[[np.argmin(np.abs(good - k))]]
         mean = rotvecs[near].mean(axis=0)
+        if cuts[k]:
+            out[k], reliable[k] = mean, False
+            continue
         spread = np.sqrt(np.mean(np.sum((rotvecs[near] - mean) ** 2, axis=1)))
         jump = np.linalg.norm(rotvecs[k] - mean)
         if jump <= max(JUMP_SPREADS * spread, np.radians(MIN_JUMP_DEG)):

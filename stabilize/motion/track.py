@@ -96,6 +96,8 @@ class VisualTrack:
     # (N-1, 4) the similarity (dx, dy, a, b) left after each rotation, normalised image
     # coordinates (:mod:`stabilize.motion.residual`)
     residual: NDArray[np.float64] | None = None
+    # (N-1,) how alike each pair's frames look, 1 the same picture (:mod:`.cuts`)
+    likeness: NDArray[np.float64] | None = None
 
     @classmethod
     def from_rotations(cls, times: NDArray, rotations: NDArray) -> VisualTrack:
@@ -117,6 +119,7 @@ class VisualTrack:
             cut(self.band_support),
             None if self.samples is None else self.samples.pairs(first, stop),
             None if self.residual is None else self.residual[first:stop],
+            None if self.likeness is None else self.likeness[first:stop],
         )
 
 
