@@ -53,7 +53,7 @@ from stabilize.video.containers import container_for
 from stabilize.video.encode import EncodeError, Encoding, Mux
 from stabilize.video.encoders import unused_options
 from stabilize.video.fields import DEINTERLACE_MODES, field_times
-from stabilize.video.i420 import chroma, finer, pipe_format
+from stabilize.video.i420 import chroma, finer, is_deep
 from stabilize.video.preflight import (
     check_encoder,
     check_pix_fmt,
@@ -296,8 +296,7 @@ def pipe_notices(info: VideoInfo, encoding: Encoding, asked: bool = False) -> tu
             "are stabilised and written without it",
         )
     notices += chroma_notice(info.pix_fmt, encoding, asked)
-    deep = pipe_format(info.pix_fmt) != "yuv420p"  # a source of 10 bits or more
-    if deep and pipe_format(encoding.pix_fmt) == "yuv420p":
+    if is_deep(info.pix_fmt) and not is_deep(encoding.pix_fmt):
         why = (
             "as --pix-fmt asks" if asked else f"{encoding.codec} ({encoding.pix_fmt}) holds no more"
         )

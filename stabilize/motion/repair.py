@@ -74,14 +74,15 @@ def repair_unreliable(
     support = np.asarray(support)
     cuts = np.zeros(len(R), bool) if cuts is None else np.asarray(cuts, bool)
     supported = support >= max(MIN_SUPPORT, RELATIVE_SUPPORT * float(np.median(support)))
-    weighed = not (supported.all() or not supported.any())  # support tells pairs apart
-    if not (weighed or cuts.any()) or cuts.all():
+    # short of support, where support tells pairs apart (some have it, some do not)
+    doubtful = ~supported if supported.any() else np.zeros(len(R), bool)
+    if not (doubtful.any() or cuts.any()) or cuts.all():
         return R, np.ones(len(R), bool)
     rotvecs = so3.log_so3(R)
-    good = np.flatnonzero((supported if weighed else True) & ~cuts)
+    good = np.flatnonzero(~doubtful & ~cuts)
     out = rotvecs.copy()
     reliable = np.ones(len(R), bool)  # a frame is unreliable once it is repaired
-    for k in np.flatnonzero((~supported if weighed else False) | cuts):
+    for k in np.flatnonzero(doubtful | cuts):
         near = good[np.abs(good - k) <= REPAIR_WINDOW]
         if near.size == 0:
             near = good[[np.argmin(np.abs(good - k))]]

@@ -19,7 +19,7 @@ from stabilize.video.binary import drain, ffmpeg_exe, local, widen_pipe
 from stabilize.video.colour import UNKNOWN, Colour
 from stabilize.video.containers import Container, container_for
 from stabilize.video.encoders import DEFAULT_PRESET, EDITING_PIX_FMT, FRAME_CLOCKED, encoder_args
-from stabilize.video.i420 import chroma, pipe_format, pipe_layout
+from stabilize.video.i420 import chroma, is_deep, pipe_format, pipe_layout
 
 
 class EncodeError(RuntimeError):
@@ -77,11 +77,11 @@ class Encoding:
         >>> Encoding(pix_fmt="yuv420p").for_frames(container_for("a.mov"), "yuv420p10le").codec
         'libx264'
         """
-        deep = pipe_format(pix_fmt_in) != "yuv420p"  # 10 bits or more
+        deep = is_deep(pix_fmt_in)
         if container.pix_fmt:  # the encoder's own (GIF's palette)
             return replace(self, codec=self.codec_for(container), pix_fmt=container.pix_fmt)
         if self.pix_fmt is not None:  # asked for (--pix-fmt): its depth, not the source's
-            deep = pipe_format(self.pix_fmt) != "yuv420p"
+            deep = is_deep(self.pix_fmt)
         if container.pictures:  # an image sequence's: RGB, or JPEG's full-range YUV
             pix_fmt = self.pix_fmt or container.pictures[deep]
             return replace(self, codec=self.codec_for(container), pix_fmt=pix_fmt)
@@ -113,7 +113,7 @@ def output_args(
     container = container or container_for(path)
     codec = encoding.codec_for(container)
     pix_fmt = encoding.pix_fmt or "yuv420p"
-    deep = pipe_format(pix_fmt) != "yuv420p"  # 10 bits or more
+    deep = is_deep(pix_fmt)
     full = chroma(pix_fmt) == "4:4:4"
     args = [*encoder_args(codec, encoding.crf, encoding.preset, deep, full), "-pix_fmt", pix_fmt]
     if encoding.threads:

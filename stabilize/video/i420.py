@@ -44,6 +44,15 @@ def pipe_format(source_pix_fmt: str) -> str:
     return "yuv420p10le" if depth and int(depth.group(1)) >= 10 else "yuv420p"
 
 
+def is_deep(pix_fmt: str) -> bool:
+    """Whether FFmpeg's ``pix_fmt`` holds 10 bits or more a sample (:func:`pipe_format`).
+
+    >>> [is_deep(f) for f in ("yuv420p", "rgb24", "yuv422p10le", "rgb48le", "p010le")]
+    [False, False, True, True, True]
+    """
+    return pipe_format(pix_fmt) != "yuv420p"
+
+
 def rgb_pipe(source_pix_fmt: str) -> str:
     """The RGB pipe format that keeps a source's depth: 16 bits a channel for a source of
     10 bits or more, else 8.
@@ -51,7 +60,7 @@ def rgb_pipe(source_pix_fmt: str) -> str:
     >>> [rgb_pipe(f) for f in ("yuv422p", "rgb24", "yuv422p10le", "gbrp16le")]
     ['rgb24', 'rgb24', 'rgb48le', 'rgb48le']
     """
-    return "rgb24" if pipe_format(source_pix_fmt) == "yuv420p" else "rgb48le"
+    return "rgb48le" if is_deep(source_pix_fmt) else "rgb24"
 
 
 def has_alpha(pix_fmt: str) -> bool:
@@ -111,7 +120,7 @@ def pipe_layout(pix_fmt: str, size: tuple[int, int]) -> tuple[tuple[int, ...], t
     (3H/2, W), 8 or 10 bits (``yuv420p10le``: uint16), else RGB (H, W, 3), 8 or 16 bits
     (``rgb48le``: uint16)."""
     h, w = size
-    deep = np.uint16 if pipe_format(pix_fmt) != "yuv420p" else np.uint8
+    deep = np.uint16 if is_deep(pix_fmt) else np.uint8
     if pix_fmt.startswith("yuv420p"):
         return (h * 3 // 2, w), deep
     return (h, w, 3), deep

@@ -78,10 +78,13 @@ def check_encoder(
 def check_pix_fmt(encoding: Encoding) -> None:
     """That the encoder writes the pixel format asked for (``--pix-fmt``), as FFmpeg lists
     its formats: given another, FFmpeg picks one it writes and says so only in a warning
-    (libx264 asked for yuv410p wrote yuv420p)."""
-    codec, pix_fmt = encoding.codec or "libx264", encoding.pix_fmt
+    (libx264 asked for yuv410p wrote yuv420p). ``encoding`` is made whole
+    (:meth:`Encoding.for_frames`): its codec named."""
+    codec, pix_fmt = encoding.codec, encoding.pix_fmt
+    if codec is None or pix_fmt is None:
+        return
     written = encoder_pix_fmts(codec)
-    if pix_fmt is None or not written or pix_fmt in written:
+    if not written or pix_fmt in written:
         return
     raise OutputError(
         f"--pix-fmt {pix_fmt}: {codec} does not write it; it writes {', '.join(written)}"

@@ -16,7 +16,7 @@ from stabilize.video.binary import ffmpeg_exe, local
 from stabilize.video.colour import UNKNOWN, Colour, colour_of, dolby_vision, with_hdr10
 from stabilize.video.fields import DEINTERLACE_MODES, field_order, frame_field_order, interlaced
 from stabilize.video.first_frame import first_frame_report
-from stabilize.video.i420 import has_alpha, pipe_format
+from stabilize.video.i420 import has_alpha, is_deep
 from stabilize.video.sequence import (
     exif_orientation,
     first_image,
@@ -271,7 +271,7 @@ def _from_frames(path: Path, input_args: tuple, pix_fmt: str, details: str) -> t
     names none (:mod:`stabilize.video.fields`), the HDR10 metadata of a stream of 10
     bits or more (:mod:`stabilize.video.colour`)."""
     order, colour = field_order(details), colour_of(pix_fmt, details)
-    deep = pipe_format(pix_fmt) != "yuv420p"
+    deep = is_deep(pix_fmt)
     if order and not deep:
         return order, colour
     report = first_frame_report(path, input_args)
