@@ -176,11 +176,15 @@ class Settle:
 def estimate_again(estimator: HoughEstimator, track: VisualTrack, bands: int = 0) -> VisualTrack:
     """A track's rotations estimated again from its kept samples by another
     ``estimator`` (of the same grid: another focal length), bands too, without decoding
-    anything."""
+    anything; what the pictures said (their likeness) is kept."""
     masks = band_masks(estimator, estimator.size[0], bands)
     found, residual = _revoted(estimator, track.samples, masks)
     again = _track(track.times, found, bands)
-    return replace(again, samples=track.samples, residual=np.concatenate(residual))
+    # the likeness once went missing here, so a clip whose focal length was estimated at
+    # its end (any clip under MAX_PAIRS pairs) had no cut found
+    return replace(
+        again, samples=track.samples, residual=np.concatenate(residual), likeness=track.likeness
+    )
 
 
 def _revoted(

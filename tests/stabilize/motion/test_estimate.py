@@ -78,6 +78,22 @@ def test_bands_voted_from_the_kept_samples_are_those_of_pass_1():
     assert ((later.band_rows >= edges[:-1] - 0.02) & (later.band_rows <= edges[1:])).all()
 
 
+def test_a_track_voted_again_at_another_focal_length_keeps_its_likeness():
+    """What the pictures said (how alike each pair looks, which finds the cuts) does
+    not depend on the focal length; it went missing when a clip's focal length was
+    estimated at its end, so no cut was found in any clip under 120 pairs."""
+    clip = SAMPLE / "clip.mp4"
+    info = probe(clip)
+    track = estimate.estimate_rotations(clip, info, Settings(fov=70.0), keep_samples=True)
+    ws = flow.working_size(info.size)
+    focal = Settings(fov=50.0).focal_px(info.size) * ws.scale[0]
+    other = estimate.HoughEstimator(ws.size, focal, max_deg=Settings().max_deg)
+    again = estimate.estimate_again(other, track)
+    assert track.likeness is not None and len(track.likeness) == len(track.rotations)
+    np.testing.assert_array_equal(again.likeness, track.likeness)
+    assert so3.angular_error_deg(again.rotations, track.rotations).max() > 0.01  # voted again
+
+
 def test_a_focal_length_settled_mid_stream_votes_as_if_given():
     """Settled after the first chunk, pass 1 gives what a run at that focal length
     gives (the pairs so far voted again from their samples, bands and all); declined,
