@@ -23,6 +23,7 @@ from dataclasses import asdict, dataclass, replace
 from functools import partial
 from pathlib import Path
 from threading import Thread
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,7 +35,7 @@ from rotation.hough import warm_up
 from stabilize.gyro.log import GyroLog
 from stabilize.motion.cuts import cut_pairs
 from stabilize.motion.estimate import READOUT_BANDS, Damaged
-from stabilize.motion.focal import estimate_motion
+from stabilize.motion.focal import FocalChoice, estimate_motion
 from stabilize.motion.repair import repair_unreliable
 from stabilize.motion.residual import reexpress
 from stabilize.motion.track import VisualTrack
@@ -82,7 +83,10 @@ from stabilize.warp.render import (
     render,
     shown_notice,
 )
-from stabilize.warp.rolling import RAMP_S, within_stretch
+from stabilize.warp.rolling import RAMP_S, RollingShutter, within_stretch
+
+if TYPE_CHECKING:
+    from stabilize.shutter.readout import Readout
 
 
 @dataclass(frozen=True)
@@ -97,6 +101,20 @@ class Job:
     mux: Mux
     encoding: Encoding  # the output's encoder and pixel format, as the source's depth asks
     notices: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Turns:
+    """What pass 1 found, as the plan takes it (:func:`_rotations`)."""
+
+    R: NDArray  # (N-1, 3, 3) each pair's rotation, between the frames' middle rows
+    rolling: RollingShutter | None  # the rows' turns, under a rolling shutter
+    residual: NDArray | None  # (N-1, 4) the similarities R_t leaves
+    repaired: int  # frames whose rotation was taken from their neighbours
+    gyro: dict | None  # the gyro's summary, where the rotations came from one
+    shutter: Readout | None  # the visual readout, where measured
+    eased: int  # frames whose row turns were eased within --max-stretch
+    cuts: NDArray[np.bool_]  # (N-1,) the pairs across a change of shot
 
 
 def stabilize_video(
@@ -133,7 +151,7 @@ def stabilize_video(
     start = time.perf_counter()
     bar = progress or (lambda label, total: no_progress)
     try:
-        track, focal, rotations = _motion(src, job, settings, bar, tell)
+        track, focal, turns = _motion(src, job, settings, bar, tell)
     except Damaged as damage:  # refused before, however few frames were lost
         if job.stamps is not None:  # a sensor log's frame times count every frame
             raise
@@ -145,12 +163,20 @@ def stabilize_video(
         tell(damage.notice)
         if lead > 0:
             tell(f"damaged: the first {lead:.2f} s of video do not decode: it starts there")
-        track, focal, rotations = _damaged_motion(src, job, settings, bar, tell, damage)
-    R, rolling, residual, repaired, gyro_summary, shutter, eased = rotations
+        track, focal, turns = _damaged_motion(src, job, settings, bar, tell, damage)
     t_estimate = time.perf_counter() - start
     K = _camera_matrix(focal.px, job.info, job.lens)
     planned = plan_path(
-        track.times, R, track.support, K, job.info.size, settings, rolling, job.lens, residual
+        track.times,
+        turns.R,
+        track.support,
+        K,
+        job.info.size,
+        settings,
+        turns.rolling,
+        job.lens,
+        turns.residual,
+        turns.cuts,
     )
     t_plan = time.perf_counter() - start - t_estimate
     if planned.planner == "bent":
@@ -180,8 +206,8 @@ def stabilize_video(
         "zoom": float(planned.zoom.max()),
         "path": planned.planner,  # smoothed, optimal, bent or uncropped (CameraPath)
         "mean_support": float(np.mean(track.support)),
-        "repaired_frames": repaired,
-        "mean_rotation_deg": float(np.degrees(so3.angle(R)).mean()),
+        "repaired_frames": turns.repaired,
+        "mean_rotation_deg": float(np.degrees(so3.angle(turns.R)).mean()),
         "seconds": {
             "estimate": t_estimate,
             "plan": t_plan,
@@ -190,9 +216,9 @@ def stabilize_video(
         },
         "fps": frames / total,
         "settings": settings_summary(settings),
-        "gyro": gyro_summary,
-        "rolling_shutter": None if shutter is None else shutter.summary(),
-        "stretch_eased_frames": eased,  # rolling-shutter corrections kept within --max-stretch
+        "gyro": turns.gyro,
+        "rolling_shutter": None if turns.shutter is None else turns.shutter.summary(),
+        "stretch_eased_frames": turns.eased,  # row corrections kept within --max-stretch
         "notices": said,
     }
     return summary, planned
@@ -415,7 +441,9 @@ def dates_rows(settings: Settings, log: GyroLog | None = None, lens: Lens | None
     return visual
 
 
-def _damaged_motion(src: Path, job: Job, settings: Settings, bar, tell, damage: Damaged) -> tuple:
+def _damaged_motion(
+    src: Path, job: Job, settings: Settings, bar, tell, damage: Damaged
+) -> tuple[VisualTrack, FocalChoice, Turns]:
     """:func:`_motion` on a damaged clip's frames that decode; a gyro log they do not
     match is refused naming the damage, which no option of the log's cures."""
     from stabilize.gyro.log import GyroError
@@ -433,7 +461,9 @@ def _damaged_motion(src: Path, job: Job, settings: Settings, bar, tell, damage: 
         ) from None
 
 
-def _motion(src: Path, job: Job, settings: Settings, bar, tell) -> tuple:
+def _motion(
+    src: Path, job: Job, settings: Settings, bar, tell
+) -> tuple[VisualTrack, FocalChoice, Turns]:
     """(track, focal length, :func:`_rotations`): pass 1, with its notices."""
     bands = READOUT_BANDS if dates_rows(settings, job.log, job.lens) else 0
     # the flow vectors (about 5 KB a pair): the repair checks a jump against them, and
@@ -457,15 +487,14 @@ def _motion(src: Path, job: Job, settings: Settings, bar, tell) -> tuple:
 
 def _rotations(
     settings: Settings, job: Job, track: VisualTrack, focal: float, tell: Callable[[str], None]
-) -> tuple:
-    """(R_t, rolling-shutter turns or None, the similarities R_t leaves, frames repaired,
-    gyro summary or None, the visual readout or None, frames whose row turns were
-    eased): from the gyro log when there is
-    one, else the visual track with unreliable frames repaired (and no residual motion on
-    them); under a rolling shutter, the rotations between the frames' middle rows, and
-    the row turns eased where they would stretch a frame past the budget
+) -> Turns:
+    """The clip's turns: from the gyro log when there is one, else the visual track with
+    unreliable frames repaired (and no residual motion on them) and its cuts found; under
+    a rolling shutter, the rotations between the frames' middle rows, and the row turns
+    eased where they would stretch a frame past the budget
     (:func:`stabilize.warp.rolling.within_stretch`)."""
     reliable = np.ones(len(track.rotations), bool)
+    cuts = np.zeros(len(track.rotations), bool)
     shutter = None
     from_gyro = _gyro_rotations(settings, job, track, tell)
     if from_gyro is not None:
@@ -508,7 +537,7 @@ def _rotations(
         residual = reexpress(residual, track.rotations, R, focal, job.info.size)
     if residual is not None:
         residual = np.where(reliable[:, None], residual, 0.0)
-    return R, rolling, residual, int((~reliable).sum()), summary, shutter, eased
+    return Turns(R, rolling, residual, int((~reliable).sum()), summary, shutter, eased, cuts)
 
 
 def _cuts(track: VisualTrack, tell: Callable[[str], None]) -> NDArray[np.bool_]:

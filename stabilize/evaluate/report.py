@@ -16,9 +16,11 @@ from stabilize.warp.camera_path import CameraPath
 
 
 def write_path(path: Path, planned: CameraPath) -> None:
-    """Per frame: t, raw and smoothed orientation (w,x,y,z), zoom, homography (9 entries)."""
+    """Per frame: t, raw and smoothed orientation (w,x,y,z), zoom, homography (9 entries),
+    and the shot it belongs to (0 up to its first cut)."""
     raw = Rotation.from_matrix(planned.raw).as_quat(scalar_first=True)
     smooth = Rotation.from_matrix(planned.smooth).as_quat(scalar_first=True)
+    shot = np.searchsorted(planned.shots, np.arange(len(planned.times)), side="right") - 1
     with open(path, "w", newline="") as f:
         writer = csv.writer(f)
         writer.writerow(
@@ -35,6 +37,7 @@ def write_path(path: Path, planned: CameraPath) -> None:
                 "smooth_z",
                 "zoom",
                 *(f"h{i}{j}" for i in range(3) for j in range(3)),
+                "shot",
             ]
         )
         for k, t in enumerate(planned.times):
@@ -46,12 +49,14 @@ def write_path(path: Path, planned: CameraPath) -> None:
                     *(f"{v:.9f}" for v in smooth[k]),
                     f"{planned.zoom[k]:.6f}",
                     *(f"{v:.9g}" for v in planned.homographies[k].ravel()),
+                    shot[k],
                 ]
             )
 
 
 def plot_trajectory(path: Path, planned: CameraPath) -> None:
-    """Raw against smoothed pitch, yaw and roll (the camera's own rotation, degrees)."""
+    """Raw against smoothed pitch, yaw and roll (the camera's own rotation, degrees), and
+    the zoom; each shot's own path, an edited clip's cuts dashed between them."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -60,14 +65,25 @@ def plot_trajectory(path: Path, planned: CameraPath) -> None:
     # The camera's own orientation is Oᵀ; its rotation vector is (pitch, yaw, roll).
     raw = np.degrees(so3.log_so3(np.swapaxes(planned.raw, -1, -2)))
     smooth = np.degrees(so3.log_so3(np.swapaxes(planned.smooth, -1, -2)))
+    # a planned path jumps at a cut, where no camera moved: its line is broken there
+    starts = list(planned.shots[1:])
+    times = np.insert(planned.times, starts, np.nan)
+    smooth, zoom = (
+        np.insert(smooth, starts, np.nan, axis=0),
+        np.insert(planned.zoom, starts, np.nan),
+    )
+    cuts = (planned.times[starts] + planned.times[np.subtract(starts, 1)]) / 2
     fig, axes = plt.subplots(4, 1, figsize=(10, 9), sharex=True)
     for ax, k, name in zip(axes, (1, 0, 2), ("yaw", "pitch", "roll"), strict=False):
         ax.plot(planned.times, raw[:, k], lw=1, color="0.55", label="raw")
-        ax.plot(planned.times, smooth[:, k], lw=2, color="C0", label="smoothed")
+        ax.plot(times, smooth[:, k], lw=2, color="C0", label="smoothed")
         ax.set_ylabel(f"{name} (°)")
         ax.grid(alpha=0.3)
+    for ax in axes:
+        for at, t in enumerate(cuts):
+            ax.axvline(t, color="0.3", ls="--", lw=1, label=None if at else "cut")
     axes[0].legend(loc="upper left")
-    axes[3].plot(planned.times, planned.zoom, color="C3")
+    axes[3].plot(times, zoom, color="C3")
     axes[3].set_ylabel("zoom")
     axes[3].set_xlabel("time (s)")
     axes[3].grid(alpha=0.3)

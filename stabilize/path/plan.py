@@ -12,9 +12,15 @@ bent, :mod:`.budget`, and one within it kept); then the crop mode picks the zoom
 
 With a rolling shutter, each frame's correction also undoes the camera's turn between
 its middle row and every other row, C_t(y) = C_t R_t(y)ᵀ.
+
+An edited clip is planned shot by shot, each shot as a clip of its own (its path, its
+zoom): no camera moves across a cut, and a path smoothed across one carries the motion of
+one shot into the other.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -33,6 +39,8 @@ from stabilize.warp.lens import Lens
 from stabilize.warp.rolling import RollingShutter
 
 LOOSER = 0.35  # the smoothing time constant, as a share, of the path bent towards first
+# how each shot's path was planned, the worst first: the joined path is called the worst
+PLANNERS = ("bent", "optimal", "smoothed", "uncropped")
 
 
 def plan_path(
@@ -45,12 +53,32 @@ def plan_path(
     rolling: RollingShutter | None = None,
     lens: Lens | None = None,
     residual: NDArray | None = None,
+    cuts: NDArray | None = None,
 ) -> CameraPath:
     """The planned path of frames at ``times`` with rotations R_t (N-1, 3, 3), and the
     similarities (N-1, 4) they leave (``residual``; compensated as ``settings.motion``
-    says)."""
+    says). Pairs that ``cuts`` (N-1,) marks are changes of shot: each shot is planned
+    on its own (:func:`shots`), and R_t across a cut only links the raw orientations."""
     if settings.crop not in CROP_MODES:
         raise ValueError(f"crop must be one of {tuple(CROP_MODES)}, got {settings.crop!r}")
+    spans = shots(np.zeros(len(rotations), bool) if cuts is None else cuts)
+    if len(spans) > 1:
+        planned = [
+            plan_path(
+                times[first:stop],
+                rotations[first : stop - 1],
+                support[first : stop - 1],
+                K,
+                size,
+                settings,
+                None if rolling is None else rolling.frames(first, stop),
+                lens,
+                None if residual is None else residual[first : stop - 1],
+            )
+            for first, stop in spans
+        ]
+        joined = _joined(planned, times, rotations, support)
+        return replace(joined, shots=tuple(first for first, _ in spans))
     measured = residual is not None and settings.motion != "rotation"
     if not measured:
         residual = np.zeros((len(rotations), 4))
@@ -144,6 +172,57 @@ def plan_path(
     by_row = None if rolling is None else corrections(path)
     rows, S = framing.rows, path.turn
     return CameraPath(times, rotations, support, O, S, zoom, H, K, by_row, rows, lens, D, planner)
+
+
+def shots(cuts: NDArray) -> list[tuple[int, int]]:
+    """The shots, (first frame, stop) each, of a clip whose pairs (frames t, t + 1) that
+    ``cuts`` marks are changes of shot. A shot of one frame (a flash between two cuts)
+    goes with the shot after it (the last, with the one before): a path needs a pair.
+
+    >>> shots(np.array([False, False, True, False]))  # frames 0-2 | 3-4
+    [(0, 3), (3, 5)]
+    >>> shots(np.array([False, True, True, False]))  # frame 2 alone joins 3-4
+    [(0, 2), (2, 5)]
+    """
+    starts = [0]
+    for pair in np.flatnonzero(np.asarray(cuts, bool)):
+        if pair + 1 - starts[-1] >= 2:
+            starts.append(int(pair) + 1)
+    stop = len(cuts) + 1
+    if len(starts) > 1 and stop - starts[-1] < 2:
+        starts.pop()
+    return list(zip(starts, [*starts[1:], stop], strict=True))
+
+
+def _joined(
+    planned: list[CameraPath], times: NDArray, rotations: NDArray, support: NDArray
+) -> CameraPath:
+    """The shots' paths as the clip's: the raw orientations O_t chained across the cuts
+    (R_t there is its neighbours', :mod:`stabilize.motion.repair`), and each frame's
+    planned S_t = (S'_t O'_tᵀ) O_t, the turn its shot planned (its path S', its raw O')
+    applied to the clip's raw orientation."""
+
+    def joined(name: str) -> NDArray:
+        return np.concatenate([getattr(shot, name) for shot in planned])
+
+    O = orientations_from_rotations(rotations)
+    turns = joined("smooth") @ np.swapaxes(joined("raw"), -1, -2)
+    first = planned[0]
+    return CameraPath(
+        times,
+        rotations,
+        support,
+        O,
+        turns @ O,
+        joined("zoom"),
+        joined("homographies"),
+        first.K,
+        None if first.row_corrections is None else joined("row_corrections"),
+        first.knot_rows,
+        first.lens,
+        joined("shift"),
+        min((shot.planner for shot in planned), key=PLANNERS.index),
+    )
 
 
 def _ceiling(raw: Trajectory, path: Trajectory, parts: tuple[int, ...]) -> NDArray:

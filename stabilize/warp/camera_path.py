@@ -48,6 +48,9 @@ class CameraPath:
     # that programme found no answer), "bent" (over the budget where it found none, so
     # bent towards the raw one) or "uncropped"
     planner: str = "smoothed"
+    # The first frame of each shot, each planned on its own (stabilize.path.plan.shots):
+    # an edited clip's cuts
+    shots: tuple[int, ...] = (0,)
 
     def corrections(self, frames: int | slice | NDArray = slice(None)) -> NDArray:
         """C_t (3, 3) of frame t's middle row, or a stack of them (every frame's by

@@ -28,6 +28,10 @@ class RollingShutter:
         C (N, 3, 3)."""
         return C[:, None] @ np.swapaxes(self.turns[frames], -1, -2)
 
+    def frames(self, first: int, stop: int) -> RollingShutter:
+        """The turns of frames first..stop-1 alone."""
+        return RollingShutter(self.turns[first:stop], self.rows)
+
     def at(self, frames: NDArray, rows: NDArray) -> NDArray[np.float64]:
         """D_k(y) (n, M, 3, 3) of ``frames`` (n,) at input ``rows`` ((M,) or (n, M)),
         linear between the knot rows (the turns between knots are tiny)."""

@@ -54,6 +54,9 @@ def test_a_cut_is_found_and_no_turn_is_read_across_it(two_shots, tmp_path):
     steps = np.degrees(so3.angle(path.rotations))
     at = int(np.argmin(np.abs(path.times[1:] - 1.0)))
     assert steps[at] <= np.percentile(np.delete(steps, at), 90)  # as its neighbours turn
+    # each shot planned as a clip of its own: karma's steady flight keeps its view
+    # (zoom 1.011) where hero7's walk needs 1.148, once spent on both
+    assert path.zoom[at + 1] < 1.05 < path.zoom[at]
 
 
 def test_a_clip_of_one_shot_has_no_cut(tmp_path):

@@ -137,3 +137,30 @@ def test_the_path_says_how_it_was_planned(monkeypatch):
     assert name == "bent" and bent.zoom.max() <= 1.1 + 1e-9
     C = bent.corrections()
     assert all(covers(K, c, z + 1e-6, SIZE) for c, z in zip(C, bent.zoom, strict=True))
+
+
+def test_an_edited_clip_is_planned_shot_by_shot():
+    # A 20°/s pan cut to a still shot: smoothed across the cut, the pan ran on into the
+    # second shot as a drift (0.28° a frame at its start on a rendered pair, and the path
+    # then turned back to its own), and the second shot's crop was the first's
+    _, pan = shaky_path(n=60, seed=1, shake_deg=0.3, pan_deg_s=20.0)
+    _, still_shot = shaky_path(n=60, seed=2, shake_deg=0.3)
+    steps = [O[1:] @ np.swapaxes(O[:-1], -1, -2) for O in (pan, still_shot)]
+    R = np.concatenate([steps[0], np.eye(3)[None], steps[1]])  # the cut's turn: none
+    cuts = np.zeros(len(R), bool)
+    cuts[59] = True
+    times = np.arange(120) / 30.0
+    settings = Settings(max_zoom=1.3)
+
+    def speeds(planned):
+        S = planned.smooth
+        return np.degrees(so3.angle(S[1:] @ np.swapaxes(S[:-1], -1, -2)))
+
+    apart = plan_path(times, R, np.ones(len(R)), K, SIZE, settings, cuts=cuts)
+    across = plan_path(times, R, np.ones(len(R)), K, SIZE, settings)
+    assert speeds(apart)[60:].max() < 0.05 < 0.1 < speeds(across)[60:70].min()
+    assert speeds(apart)[40:59].min() > 0.5  # the pan followed to its end (0.67° a frame)
+    assert apart.zoom[60] < apart.zoom[0] == apart.zoom[59]  # each shot its own crop
+    np.testing.assert_allclose(apart.raw, across.raw)  # the raw path runs on through it
+    C = apart.corrections()
+    assert all(covers(K, c, z + 1e-6, SIZE) for c, z in zip(C, apart.zoom, strict=True))
