@@ -88,6 +88,8 @@ from stabilize.warp.rolling import RAMP_S, RollingShutter, within_stretch
 if TYPE_CHECKING:
     from stabilize.shutter.readout import Readout
 
+SAID_CUTS = 10  # the cuts a notice names by their times
+
 
 @dataclass(frozen=True)
 class Job:
@@ -545,9 +547,18 @@ def _cuts(track: VisualTrack, tell: Callable[[str], None]) -> NDArray[np.bool_]:
     if track.likeness is None:
         return np.zeros(len(track.support), bool)
     cuts = cut_pairs(track.likeness, track.support)
-    if cuts.any():
-        at = ", ".join(f"{t:.2f} s" for t in track.times[1:][cuts])
-        tell(f"a cut (a change of shot) at {at}: its turn is taken from the frames beside it")
+    times = track.times[1:][cuts]  # the first frame of each new shot
+    at = ", ".join(f"{t:.2f} s" for t in times[:SAID_CUTS])
+    more = f" and {len(times) - SAID_CUTS} more" if len(times) > SAID_CUTS else ""
+    planned = "and each shot is planned on its own"
+    if len(times) == 1:
+        said = f"its turn is taken from the frames beside it, {planned}"
+        tell(f"a cut (a change of shot) at {at}: {said}")
+    elif len(times):
+        tell(
+            f"{len(times)} cuts (changes of shot) at {at}{more}: their turns are taken from the "
+            f"frames beside them, {planned}"
+        )
     return cuts
 
 

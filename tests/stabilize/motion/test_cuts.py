@@ -4,6 +4,7 @@ across them."""
 from __future__ import annotations
 
 import subprocess
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -56,8 +57,8 @@ def test_a_cut_is_found_and_no_turn_is_read_across_it(two_shots, tmp_path):
     # the vote read a jump there, which the smoothed path spread over a second each side
     summary, path = stabilize_video(two_shots, tmp_path / "out.mp4", Settings(fov=70.0))
     assert (
-        "a cut (a change of shot) at 1.00 s: its turn is taken from the frames beside it"
-        in (summary["notices"])
+        "a cut (a change of shot) at 1.00 s: its turn is taken from the frames beside it, "
+        "and each shot is planned on its own" in (summary["notices"])
     )
     steps = np.degrees(so3.angle(path.rotations))
     at = int(np.argmin(np.abs(path.times[1:] - 1.0)))
@@ -80,3 +81,21 @@ def test_a_cut_between_two_shots_of_one_place_is_found(shared, tmp_path):
     summary, path = stabilize_video(clip, tmp_path / "out.mp4", Settings(fov=70.0))
     assert any("a cut (a change of shot) at 1.00 s" in n for n in summary["notices"])
     assert path.shots == (0, 30)
+
+
+def test_a_montage_is_said_in_one_line_naming_its_first_ten_cuts():
+    from stabilize.motion.track import VisualTrack
+    from stabilize.pipeline import _cuts
+
+    n = 60
+    alike = np.full(n, 0.99)
+    alike[4::5] = 0.2  # a cut every fifth pair: 12
+    track = VisualTrack.from_rotations(np.arange(n + 1) / 30, np.repeat(np.eye(3)[None], n, 0))
+    track = replace(track, support=np.full(n, 0.01), likeness=alike)
+    said: list[str] = []
+    assert _cuts(track, said.append).sum() == 12
+    assert said == [
+        "12 cuts (changes of shot) at 0.17 s, 0.33 s, 0.50 s, 0.67 s, 0.83 s, 1.00 s, 1.17 s, "
+        "1.33 s, 1.50 s, 1.67 s and 2 more: their turns are taken from the frames beside them, "
+        "and each shot is planned on its own"
+    ]
