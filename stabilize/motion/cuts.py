@@ -21,10 +21,16 @@ A cut between two shots of one place (karma's flight cut from its 4th second to 
 0.916) looks alike enough, but far less alike than the pairs around it: its unlikeness,
 1 - likeness, is 189 times the median of the 8 pairs' on each side (0.084 against
 0.0004), and the vote read a 1.65° jump there. Such a pair is a cut too where it reads
-under ``ALIKE`` and over ``DROP`` times its neighbours' median. The 21 of those 360 cuts
-that read over 0.6 read 0.60-0.82 and 28-397 times their neighbours' unlikeness; no pair
-of the real clips reads over 14 (cockatoo's, at 0.908, with 3.7% of its flow agreeing),
-and of the pairs under 3%, over 8.2.
+under ``ALIKE`` and over ``DROP`` times its neighbours' median, and alone: a cut changes
+the picture once, and the pairs beside it look as alike as their shot's others (each
+under ``ALONE`` of its unlikeness), where a subject sweeping through the frame makes
+several unlike pairs in a row (cockatoo's middle third, the bird's head swinging past:
+0.896 then 0.934, and 0.721, 0.84, 0.719, 36-130 times their neighbours' unlikeness,
+with none of the flow agreeing). The 21 of those 360 cuts that read over 0.6 read
+0.60-0.82 and 28-397 times their neighbours' unlikeness; no pair of the real clips reads
+over 14 (cockatoo's, at 0.908, with 3.7% of its flow agreeing), and of the pairs under
+3%, over 8.2, nor any alone in their views at 640 px, zoomed in two or three times, at
+half the frame rate or compressed at CRF 32.
 """
 
 from __future__ import annotations
@@ -42,6 +48,7 @@ LIKENESS = 0.6  # the correlation under which two frames look alike nowhere
 ALIKE = 0.95  # ... and under which they may be a cut, far less alike than their neighbours
 DROP = 25.0  # ... by this many times the median unlikeness of the NEIGHBOURS pairs each side
 NEIGHBOURS = 8
+ALONE = 0.25  # ... and where the pairs beside it are this much less unlike, or less
 
 
 def thumbnail(frame: NDArray) -> NDArray[np.float32]:
@@ -93,7 +100,12 @@ def cut_pairs(likenesses: NDArray, support: NDArray) -> NDArray[np.bool_]:
 def drops(likenesses: NDArray) -> NDArray[np.bool_]:
     """Which pairs look far less alike than their neighbours: under ``ALIKE``, and
     unlike, 1 - likeness, over ``DROP`` times the median unlikeness of the
-    ``NEIGHBOURS`` pairs on each side (fewer at the clip's ends; none: no drop)."""
+    ``NEIGHBOURS`` pairs on each side (fewer at the clip's ends; none: no drop), and
+    over the unlikeness of each pair beside it divided by ``ALONE``.
+
+    >>> drops(np.array([0.999, 0.998, 0.9, 0.999, 0.999, 0.9, 0.95, 0.999, 0.998]))
+    array([False, False,  True, False, False, False, False, False, False])
+    """
     unlike = 1.0 - np.asarray(likenesses, dtype=np.float64)
     padded = np.pad(unlike, NEIGHBOURS, constant_values=np.nan)
     around = np.lib.stride_tricks.sliding_window_view(padded, 2 * NEIGHBOURS + 1).copy()
@@ -101,4 +113,5 @@ def drops(likenesses: NDArray) -> NDArray[np.bool_]:
     counted = np.isfinite(around).any(axis=1)
     typical = np.full(len(unlike), np.inf)
     typical[counted] = np.nanmedian(around[counted], axis=1)
-    return (unlike > 1.0 - ALIKE) & (unlike > DROP * typical)
+    beside = np.maximum(np.r_[0.0, unlike[:-1]], np.r_[unlike[1:], 0.0])
+    return (unlike > 1.0 - ALIKE) & (unlike > DROP * typical) & (beside < ALONE * unlike)

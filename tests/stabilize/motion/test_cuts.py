@@ -45,6 +45,16 @@ def edited(out: Path, *shots: tuple[Path, float]) -> Path:
     return out
 
 
+def test_a_run_of_unlike_pairs_is_a_subject_sweeping_past_not_a_cut():
+    # cockatoo's middle third: the bird's head swings past, none of the flow agrees, and
+    # three pairs in a row read 36-130 times their neighbours' unlikeness
+    calm = [0.999, 0.998, 0.999, 0.997, 0.999, 0.998, 0.999, 0.999]
+    sweep = np.array([*calm, 0.721, 0.84, 0.719, *calm])
+    assert not cut_pairs(sweep, np.zeros(len(sweep))).any()
+    once = np.array([*calm, 0.84, *calm])  # the same drop, alone: a cut
+    np.testing.assert_array_equal(np.flatnonzero(cut_pairs(once, np.zeros(len(once)))), [8])
+
+
 @pytest.fixture(scope="module")
 def two_shots(shared: Path, tmp_path_factory) -> Path:
     """A second of hero7's walk cut to a second of karma's flight."""
