@@ -66,13 +66,13 @@ def plot_trajectory(path: Path, planned: CameraPath) -> None:
     raw = np.degrees(so3.log_so3(np.swapaxes(planned.raw, -1, -2)))
     smooth = np.degrees(so3.log_so3(np.swapaxes(planned.smooth, -1, -2)))
     # a planned path jumps at a cut, where no camera moved: its line is broken there
-    starts = list(planned.shots[1:])
+    starts = np.array(planned.shots[1:], dtype=int)
     times = np.insert(planned.times, starts, np.nan)
     smooth, zoom = (
         np.insert(smooth, starts, np.nan, axis=0),
         np.insert(planned.zoom, starts, np.nan),
     )
-    cuts = (planned.times[starts] + planned.times[np.subtract(starts, 1)]) / 2
+    cuts = (planned.times[starts] + planned.times[starts - 1]) / 2
     fig, axes = plt.subplots(4, 1, figsize=(10, 9), sharex=True)
     for ax, k, name in zip(axes, (1, 0, 2), ("yaw", "pitch", "roll"), strict=False):
         ax.plot(planned.times, raw[:, k], lw=1, color="0.55", label="raw")
