@@ -18,7 +18,13 @@ from numpy.typing import NDArray
 from stabilize.video.binary import drain, ffmpeg_exe, local, widen_pipe
 from stabilize.video.colour import UNKNOWN, Colour
 from stabilize.video.containers import Container, container_for
-from stabilize.video.encoders import DEFAULT_PRESET, EDITING_PIX_FMT, FRAME_CLOCKED, encoder_args
+from stabilize.video.encoders import (
+    DEFAULT_PRESET,
+    EDITING_FULL_PIX_FMT,
+    EDITING_PIX_FMT,
+    FRAME_CLOCKED,
+    encoder_args,
+)
 from stabilize.video.i420 import chroma, is_deep, pipe_format, pipe_layout
 
 
@@ -45,15 +51,17 @@ class Encoding:
         """The encoder to use in ``container``."""
         return self.codec or container.video_encoder
 
-    def for_frames(self, container: Container, pix_fmt_in: str) -> Encoding:
-        """This encoding made whole for frames piped as ``pix_fmt_in`` into ``container``.
+    def for_frames(self, container: Container, pix_fmt_in: str, source: str = "") -> Encoding:
+        """This encoding made whole for frames piped as ``pix_fmt_in`` into ``container``,
+        from a source of pixel format ``source`` (FFmpeg's name; "": unknown).
 
         A 10-bit pipe (``yuv420p10le``, or 16-bit RGB, ``rgb48le``) is encoded at 10
         bits, by the container's encoder for deep sources where none is asked for: HEVC
         in MP4, MOV, MKV and TS, since H.264 at 10 bits plays neither on Apple's devices
         nor in most browsers. Frames are written as 4:2:0, which every player plays,
         unless a pixel format is asked for or the encoder is an editing codec, which
-        writes its own 4:2:2 (:data:`~stabilize.video.encoders.EDITING_PIX_FMT`). An
+        writes its own 4:2:2 (:data:`~stabilize.video.encoders.EDITING_PIX_FMT`), or its
+        4:4:4 from a 4:4:4 or RGB source. An
         image sequence's pictures take their format's pixels (16 bits a channel in PNG
         and TIFF for a deep source).
 
@@ -69,6 +77,8 @@ class Encoding:
         'yuv420p10le'
         >>> Encoding(codec="prores_ks").for_frames(container_for("a.mov"), "rgb24").pix_fmt
         'yuv422p10le'
+        >>> Encoding(codec="dnxhd").for_frames(container_for("a.mxf"), "rgb24", "gbrp").pix_fmt
+        'yuv444p10le'
         >>> Encoding().for_frames(container_for("f/%05d.png"), "yuv420p10le").pix_fmt
         'rgb48be'
         >>> asked = Encoding(pix_fmt="yuv422p10le").for_frames(container_for("a.mov"), "yuv420p")
@@ -88,6 +98,8 @@ class Encoding:
         codec = self.codec or (container.deep_encoder if deep else None) or container.video_encoder
         if self.pix_fmt is not None:
             return replace(self, codec=codec)
+        if codec in EDITING_PIX_FMT and chroma(source) == "4:4:4":
+            return replace(self, codec=codec, pix_fmt=EDITING_FULL_PIX_FMT)
         if codec in EDITING_PIX_FMT:
             return replace(self, codec=codec, pix_fmt=EDITING_PIX_FMT[codec][deep])
         return replace(self, codec=codec, pix_fmt=pipe_format(pix_fmt_in))

@@ -124,6 +124,10 @@ EDITING_PIX_FMT: dict[str, tuple[str, str]] = {
     "prores_ks": ("yuv422p10le", "yuv422p10le"),
     "prores_aw": ("yuv422p10le", "yuv422p10le"),
 }
+# ... and for a 4:4:4 or RGB source (a ProRes 4444 master, RGB pictures), their 4:4:4
+# (ProRes 4444, DNxHR 444, FULL_CHROMA_PROFILES: 10 bits at either depth), so an
+# editor's full colour comes back whole without --pix-fmt (it was written 4:2:2)
+EDITING_FULL_PIX_FMT = "yuv444p10le"
 
 
 def encoder_args(

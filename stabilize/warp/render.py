@@ -187,7 +187,7 @@ def piped_format(info: VideoInfo, settings: Settings, container: Container) -> s
     planar, rgb = i420.pipe_format(info.pix_fmt), i420.rgb_pipe(info.pix_fmt)
     if not (i420.supports(info.size) and i420.supports(frame_size(info, settings))):
         return rgb
-    written = settings.encoding.for_frames(container, planar).pix_fmt
+    written = settings.encoding.for_frames(container, planar, info.pix_fmt).pix_fmt
     fine = i420.finer(info.pix_fmt, planar) and i420.finer(written, planar)
     return rgb if fine else planar
 
@@ -195,7 +195,8 @@ def piped_format(info: VideoInfo, settings: Settings, container: Container) -> s
 def output_encoding(info: VideoInfo, settings: Settings, container: Container) -> Encoding:
     """The encoder and pixel format the output is written with: ``--codec``, else the
     container's default for the source's depth (:meth:`Encoding.for_frames`)."""
-    return settings.encoding.for_frames(container, piped_format(info, settings, container))
+    piped = piped_format(info, settings, container)
+    return settings.encoding.for_frames(container, piped, info.pix_fmt)
 
 
 def encoded_size(info: VideoInfo, settings: Settings) -> tuple[int, int]:

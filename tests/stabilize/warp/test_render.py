@@ -8,6 +8,7 @@ import subprocess
 from dataclasses import replace
 from pathlib import Path
 
+import av
 import cv2
 import numpy as np
 import pytest
@@ -63,23 +64,24 @@ def test_an_odd_side_pipes_rgb_at_the_sources_depth():
     assert piped_format(info, Settings(), container_for("out.mkv")) == "rgb48le"
 
 
-def _striped() -> np.ndarray:
-    """The sample's first frame (RGB), its rows alternately warmer and cooler: the finest
-    vertical colour detail, which 4:2:0 averages away."""
-    rgb = next(iter(read_frames(SAMPLE / "clip.mp4"))).astype(np.int16)
-    rgb[0::2, :, 0] += 40
-    rgb[1::2, :, 2] += 40
-    return np.clip(rgb, 0, 255).astype(np.uint8)
+def _striped(axis: int = 0) -> np.ndarray:
+    """The sample's first frame (RGB), its rows (``axis`` 0; 1: columns) alternately
+    warmer and cooler: the finest colour detail, which 4:2:0 averages away (and 4:2:2,
+    across)."""
+    rgb = np.moveaxis(next(iter(read_frames(SAMPLE / "clip.mp4"))).astype(np.int16), axis, 0)
+    rgb[0::2, ..., 0] += 40
+    rgb[1::2, ..., 2] += 40
+    return np.moveaxis(np.clip(rgb, 0, 255).astype(np.uint8), 0, axis)
 
 
 def _write_png(path: Path, rgb: np.ndarray) -> None:
     cv2.imwrite(str(path), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
 
 
-def _still_clip(folder: Path, pix_fmt: str, codec: str, suffix: str) -> Path:
-    """Six frames of the striped picture, encoded so."""
+def _still_clip(folder: Path, pix_fmt: str, codec: str, suffix: str, axis: int = 0) -> Path:
+    """Six frames of the striped picture (:func:`_striped`), encoded so."""
     picture, clip = folder / "still.png", folder / f"still{suffix}"
-    _write_png(picture, _striped())
+    _write_png(picture, _striped(axis))
     cmd = [ffmpeg_exe(), "-v", "error", "-loop", "1", "-framerate", "30", "-i", str(picture)]
     cmd += ["-frames:v", "6", "-c:v", codec, "-pix_fmt", pix_fmt, str(clip)]
     subprocess.run(cmd, check=True)
@@ -111,6 +113,27 @@ def test_a_4_2_2_source_keeps_its_colour(tmp_path, encoding):
     red = [p[h * w + h * w // 2 :].reshape(h, w // 2) for p in (source, written)]  # Cr
     stripes = [np.abs(np.diff(v[8:-8, 8:-8], axis=0)).mean() for v in red]
     assert stripes[1] > 0.9 * stripes[0] > 20  # row to row, as the source has it
+    assert np.abs(red[1] - red[0])[8:-8, 8:-8].mean() < 2  # of 1023
+
+
+@pytest.mark.parametrize(
+    ("codec", "suffix", "profile"), [("prores_ks", ".mov", "4444"), ("dnxhd", ".mxf", "DNXHR 444")]
+)
+def test_a_4_4_4_source_into_an_editing_codec_keeps_its_colour(tmp_path, codec, suffix, profile):
+    # a ProRes 4444 master came back as ProRes 422 HQ, its colour halved across, with a
+    # notice naming --pix-fmt as the way to keep it
+    clip = _still_clip(tmp_path, "yuv444p10le", "prores_ks", ".mov", axis=1)
+    out = tmp_path / f"out{suffix}"
+    summary, _ = stabilize_video(clip, out, replace(STILL, encoding=Encoding(codec=codec)))
+    assert not any("colour" in n for n in summary["notices"])
+    assert probe(out).pix_fmt in ("yuv444p10le", "yuv444p12le")  # ProRes 4444 decodes at 12
+    with av.open(str(out)) as written:
+        assert written.streams.video[0].codec_context.profile == profile
+    h, w = probe(clip).size
+    source, written = (_planes(p, "yuv444p10le").astype(float) for p in (clip, out))
+    red = [p[2 * h * w :].reshape(h, w) for p in (source, written)]  # Cr, full width
+    stripes = [np.abs(np.diff(v[8:-8, 8:-8], axis=1)).mean() for v in red]
+    assert stripes[1] > 0.9 * stripes[0] > 20  # column to column, as the source has it
     assert np.abs(red[1] - red[0])[8:-8, 8:-8].mean() < 2  # of 1023
 
 
