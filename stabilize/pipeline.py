@@ -207,6 +207,8 @@ def stabilize_video(
         "focal": focal.summary(),
         "zoom": float(planned.zoom.max()),
         "path": planned.planner,  # smoothed, optimal, bent or uncropped (CameraPath)
+        # s, the first frame of each shot after the first, each planned on its own
+        "cuts": [float(planned.times[k]) for k in planned.shots[1:]],
         "mean_support": float(np.mean(track.support)),
         "repaired_frames": turns.repaired,
         "mean_rotation_deg": float(np.degrees(so3.angle(turns.R)).mean()),

@@ -76,11 +76,13 @@ def test_a_cut_is_found_and_no_turn_is_read_across_it(two_shots, tmp_path):
     # each shot planned as a clip of its own: karma's steady flight keeps its view
     # (zoom 1.011) where hero7's walk needs 1.148, once spent on both
     assert path.zoom[at + 1] < 1.05 < path.zoom[at]
+    assert summary["cuts"] == [pytest.approx(1.0)]
 
 
 def test_a_clip_of_one_shot_has_no_cut(tmp_path):
     summary, _ = stabilize_video(SAMPLE / "clip.mp4", tmp_path / "out.mp4", Settings(fov=70.0))
     assert not any("change of shot" in n for n in summary["notices"])
+    assert summary["cuts"] == []
 
 
 def test_a_cut_between_two_shots_of_one_place_is_found(shared, tmp_path):
