@@ -68,10 +68,8 @@ def plot_trajectory(path: Path, planned: CameraPath) -> None:
     # a planned path jumps at a cut, where no camera moved: its line is broken there
     starts = np.array(planned.shots[1:], dtype=int)
     times = np.insert(planned.times, starts, np.nan)
-    smooth, zoom = (
-        np.insert(smooth, starts, np.nan, axis=0),
-        np.insert(planned.zoom, starts, np.nan),
-    )
+    smooth = np.insert(smooth, starts, np.nan, axis=0)
+    zoom = np.insert(planned.zoom, starts, np.nan)
     cuts = (planned.times[starts] + planned.times[starts - 1]) / 2
     fig, axes = plt.subplots(4, 1, figsize=(10, 9), sharex=True)
     for ax, k, name in zip(axes, (1, 0, 2), ("yaw", "pitch", "roll"), strict=False):

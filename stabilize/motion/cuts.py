@@ -48,7 +48,7 @@ LIKENESS = 0.6  # the correlation under which two frames look alike nowhere
 ALIKE = 0.95  # ... and under which they may be a cut, far less alike than their neighbours
 DROP = 25.0  # ... by this many times the median unlikeness of the NEIGHBOURS pairs each side
 NEIGHBOURS = 8
-ALONE = 0.25  # ... and where the pairs beside it are this much less unlike, or less
+ALONE = 0.25  # ... and alone: each pair beside it under this share of its unlikeness
 
 
 def thumbnail(frame: NDArray) -> NDArray[np.float32]:
@@ -101,7 +101,7 @@ def drops(likenesses: NDArray) -> NDArray[np.bool_]:
     """Which pairs look far less alike than their neighbours: under ``ALIKE``, and
     unlike, 1 - likeness, over ``DROP`` times the median unlikeness of the
     ``NEIGHBOURS`` pairs on each side (fewer at the clip's ends; none: no drop), and
-    over the unlikeness of each pair beside it divided by ``ALONE``.
+    alone: each pair beside it under ``ALONE`` of its unlikeness.
 
     >>> drops(np.array([0.999, 0.998, 0.9, 0.999, 0.999, 0.9, 0.95, 0.999, 0.998]))
     array([False, False,  True, False, False, False, False, False, False])

@@ -61,9 +61,8 @@ class Encoding:
         nor in most browsers. Frames are written as 4:2:0, which every player plays,
         unless a pixel format is asked for or the encoder is an editing codec, which
         writes its own 4:2:2 (:data:`~stabilize.video.encoders.EDITING_PIX_FMT`), or its
-        4:4:4 from a 4:4:4 or RGB source. An
-        image sequence's pictures take their format's pixels (16 bits a channel in PNG
-        and TIFF for a deep source).
+        4:4:4 from a 4:4:4 or RGB source. An image sequence's pictures take their
+        format's pixels (16 bits a channel in PNG and TIFF for a deep source).
 
         >>> from stabilize.video.containers import container_for
         >>> deep = Encoding().for_frames(container_for("a.mov"), "yuv420p10le")
