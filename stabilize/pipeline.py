@@ -179,6 +179,7 @@ def stabilize_video(
         job.lens,
         turns.residual,
         turns.cuts,
+        bar("planning", len(track.times)),
     )
     t_plan = time.perf_counter() - start - t_estimate
     if planned.planner == "bent":

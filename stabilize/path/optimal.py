@@ -130,13 +130,15 @@ def optimal_path(
     sigma: float = 15.0,
     middle: Middle | None = None,
     floor: float = 0.0,
+    settled: Callable[[int], None] = lambda frames: None,
 ) -> Trajectory | None:
     """The steadiest path in the sense above whose every frame covers the output; None
     where the programme fails (the caller falls back). ``corners``: the indices, among
     the border points ``sources`` gives, of the output's corners; ``ceiling`` (n, k):
     upper bounds on δ (+inf for none); ``sigma``: the low-pass's σ, in frames;
     ``middle``, ``floor``: each frame's σ_min/σ_max at the output's middle is held at
-    least ``floor`` (none for 0 or without ``middle``)."""
+    least ``floor`` (none for 0 or without ``middle``); ``settled`` hears how many
+    frames are planned so far, after each window."""
     n = len(target.turn)
     k = 3 + len(parts)
     delta = np.zeros((n, k))
@@ -166,6 +168,7 @@ def optimal_path(
             found = found if kept is None else kept
         keep = stop if stop == n else stop - OVERLAP + FIXED
         delta[start + fixed : keep] = found[fixed : keep - start]
+        settled(keep)
         if stop == n:
             break
         start = stop - OVERLAP

@@ -164,3 +164,19 @@ def test_an_edited_clip_is_planned_shot_by_shot():
     np.testing.assert_allclose(apart.raw, across.raw)  # the raw path runs on through it
     C = apart.corrections()
     assert all(covers(K, c, z + 1e-6, SIZE) for c, z in zip(C, apart.zoom, strict=True))
+
+
+@pytest.mark.parametrize("cut_at", [None, 199])
+@pytest.mark.parametrize("method", ["adaptive", "lock"])
+def test_planning_reports_every_frame_once(cut_at, method):
+    # between pass 1's bar and the render's, a 10-minute clip's path took about 13 s
+    # with no bar
+    t, O = shaky_path(n=400, shake_deg=2.0)
+    R = O[1:] @ np.swapaxes(O[:-1], -1, -2)
+    cuts = None if cut_at is None else np.arange(len(R)) == cut_at
+    heard: list[int] = []
+    settings = Settings(max_zoom=1.1, method=method)
+    plan_path(t, R, np.ones(len(R)), K, SIZE, settings, cuts=cuts, progress=heard.append)
+    assert sum(heard) == 400 and all(n > 0 for n in heard)
+    if method == "adaptive":  # the programme reports window by window (150 frames)
+        assert len(heard) >= 3
