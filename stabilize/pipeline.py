@@ -33,7 +33,7 @@ from rotation import so3
 from rotation.camera import intrinsics
 from rotation.hough import warm_up
 from stabilize.gyro.log import GyroLog
-from stabilize.motion.cuts import cut_pairs
+from stabilize.motion.cuts import cut_pairs, said_cuts
 from stabilize.motion.estimate import READOUT_BANDS, Damaged
 from stabilize.motion.focal import FocalChoice, estimate_motion
 from stabilize.motion.repair import repair_unreliable
@@ -87,8 +87,6 @@ from stabilize.warp.rolling import RAMP_S, RollingShutter, within_stretch
 
 if TYPE_CHECKING:
     from stabilize.shutter.readout import Readout
-
-SAID_CUTS = 10  # the cuts a notice names by their times
 
 
 @dataclass(frozen=True)
@@ -551,17 +549,11 @@ def _cuts(track: VisualTrack, tell: Callable[[str], None]) -> NDArray[np.bool_]:
         return np.zeros(len(track.support), bool)
     cuts = cut_pairs(track.likeness, track.support)
     times = track.times[1:][cuts]  # the first frame of each new shot
-    at = ", ".join(f"{t:.2f} s" for t in times[:SAID_CUTS])
-    more = f" and {len(times) - SAID_CUTS} more" if len(times) > SAID_CUTS else ""
     planned = "and each shot is planned on its own"
     if len(times) == 1:
-        said = f"its turn is taken from the frames beside it, {planned}"
-        tell(f"a cut (a change of shot) at {at}: {said}")
+        tell(f"{said_cuts(times)}: its turn is taken from the frames beside it, {planned}")
     elif len(times):
-        tell(
-            f"{len(times)} cuts (changes of shot) at {at}{more}: their turns are taken from the "
-            f"frames beside them, {planned}"
-        )
+        tell(f"{said_cuts(times)}: their turns are taken from the frames beside them, {planned}")
     return cuts
 
 

@@ -95,7 +95,10 @@ def write_report(folder: str | Path, planned: CameraPath, summary: dict) -> None
     """The run's report folder: rotations.csv, path.csv, trajectory.png, summary.json."""
     with atomic_folder(folder) as tmp:  # all four from this run, or the old ones kept
         rotvecs = so3.log_so3(planned.rotations)
-        write_rotations(tmp / "rotations.csv", planned.times[:-1], rotvecs, planned.support)
+        cuts = np.zeros(len(rotvecs), bool)
+        cuts[np.array(planned.shots[1:], dtype=int) - 1] = True  # where the plan restarts
+        rows = (planned.times[:-1], rotvecs, planned.support, cuts)
+        write_rotations(tmp / "rotations.csv", *rows)
         write_path(tmp / "path.csv", planned)
         plot_trajectory(tmp / "trajectory.png", planned)
         (tmp / "summary.json").write_text(json.dumps(summary, indent=2))

@@ -81,6 +81,25 @@ def likeness(a: NDArray[np.float32], b: NDArray[np.float32]) -> float:
     return best
 
 
+SAID = 10  # the cuts a notice names by their times
+
+
+def said_cuts(times: NDArray) -> str:
+    """The cuts at ``times`` (s: the first frame of each new shot) as a notice says them:
+    one, or a montage's count, its first ``SAID`` times and how many more.
+
+    >>> said_cuts(np.array([1.0]))
+    'a cut (a change of shot) at 1.00 s'
+    >>> said_cuts(np.arange(1, 13) / 2)[-33:]
+    '4.00 s, 4.50 s, 5.00 s and 2 more'
+    """
+    at = ", ".join(f"{t:.2f} s" for t in times[:SAID])
+    if len(times) == 1:
+        return f"a cut (a change of shot) at {at}"
+    more = f" and {len(times) - SAID} more" if len(times) > SAID else ""
+    return f"{len(times)} cuts (changes of shot) at {at}{more}"
+
+
 def cut_pairs(likenesses: NDArray, support: NDArray) -> NDArray[np.bool_]:
     """Which frame pairs are cuts: under ``MIN_SUPPORT`` of the flow agrees on any
     rotation, and their frames look alike nowhere (``likenesses`` under ``LIKENESS``),

@@ -1,6 +1,6 @@
 """Rotation files: one row per frame pair, ``frame,t,rx,ry,rz[,...]`` (R_t as a rotation
-vector in radians, CONVENTIONS.md). ``stabilize rotations`` writes them, with a
-``support`` column; ``stabilize synth``'s ``truth.csv`` has the same leading columns."""
+vector in radians, CONVENTIONS.md). ``stabilize rotations`` writes them, with ``support``
+and ``cut`` columns; ``stabilize synth``'s ``truth.csv`` has the same leading columns."""
 
 from __future__ import annotations
 
@@ -38,15 +38,18 @@ def read_rotations(path: str | Path) -> dict[int, NDArray[np.float64]]:
     return out
 
 
-def write_rotations(path: str | Path | TextIO, times, rotvecs, support) -> None:
-    """``frame,t,rx,ry,rz,support`` for each pair (frame k → k+1), into a file or an open
-    text stream (standard output)."""
+def write_rotations(path: str | Path | TextIO, times, rotvecs, support, cuts=None) -> None:
+    """``frame,t,rx,ry,rz,support,cut`` for each pair (frame k → k+1), into a file or an
+    open text stream (standard output); ``cut`` 1 where the pair is a change of shot
+    (:mod:`stabilize.motion.cuts`: its rotation is no camera's turn), else 0."""
+    cuts = np.zeros(len(times), bool) if cuts is None else np.asarray(cuts, bool)
     opened = open(path, "w", newline="") if isinstance(path, str | Path) else nullcontext(path)
     with opened as f:
         writer = csv.writer(f)
-        writer.writerow([*COLUMNS, "support"])
-        for k, (t, rv, s) in enumerate(zip(times, rotvecs, support, strict=True)):
-            writer.writerow([k, f"{t:.6f}", *(f"{v:.9g}" for v in rv), f"{s:.4f}"])
+        writer.writerow([*COLUMNS, "support", "cut"])
+        rows = zip(times, rotvecs, support, cuts, strict=True)
+        for k, (t, rv, s, cut) in enumerate(rows):
+            writer.writerow([k, f"{t:.6f}", *(f"{v:.9g}" for v in rv), f"{s:.4f}", int(cut)])
 
 
 def angular_errors(estimate: dict, truth: dict) -> NDArray[np.float64]:

@@ -14,7 +14,8 @@ def test_rotations_command(shaky, tmp_path):
     result = CliRunner().invoke(app, ["rotations", str(shaky), "-o", str(out), "-q", "--fov", "70"])
     assert result.exit_code == 0, result.output
     lines = out.read_text().splitlines()
-    assert lines[0] == "frame,t,rx,ry,rz,support" and len(lines) == 60
+    assert lines[0] == "frame,t,rx,ry,rz,support,cut" and len(lines) == 60
+    assert all(line.endswith(",0") for line in lines[1:])  # one shot
 
 
 def test_standard_output_takes_the_rotations_and_the_gcsv(shaky, tmp_path):
@@ -22,7 +23,7 @@ def test_standard_output_takes_the_rotations_and_the_gcsv(shaky, tmp_path):
     clip = tmp_path / "three.mp4"
     cmd = [ffmpeg_exe(), "-v", "error", "-i", str(shaky), "-frames:v", "3", str(clip)]
     subprocess.run(cmd, check=True)
-    for option, first in (("-o", "frame,t,rx,ry,rz,support"), ("--gcsv", "GYROFLOW IMU LOG")):
+    for option, first in (("-o", "frame,t,rx,ry,rz,support,cut"), ("--gcsv", "GYROFLOW IMU LOG")):
         result = CliRunner().invoke(app, ["rotations", str(clip), option, "-", "--fov", "70"])
         assert result.exit_code == 0, result.output
         assert result.stdout.splitlines()[0] == first and len(result.stdout.splitlines()) > 2

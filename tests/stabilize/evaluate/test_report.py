@@ -23,4 +23,7 @@ def test_each_frame_of_an_edited_clip_names_its_shot(tmp_path):
     with open(tmp_path / "report" / "path.csv") as f:
         rows = list(csv.DictReader(f))
     assert [int(row["shot"]) for row in rows] == [0] * 30 + [1] * 30 + [2] * 30
+    with open(tmp_path / "report" / "rotations.csv") as f:
+        pairs = list(csv.DictReader(f))
+    assert [int(row["frame"]) for row in pairs if row["cut"] == "1"] == [29, 59]
     assert (tmp_path / "report" / "trajectory.png").stat().st_size > 10_000

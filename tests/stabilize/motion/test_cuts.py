@@ -3,6 +3,7 @@ across them."""
 
 from __future__ import annotations
 
+import csv
 import subprocess
 from dataclasses import replace
 from pathlib import Path
@@ -77,6 +78,23 @@ def test_a_cut_is_found_and_no_turn_is_read_across_it(two_shots, tmp_path):
     # (zoom 1.011) where hero7's walk needs 1.148, once spent on both
     assert path.zoom[at + 1] < 1.05 < path.zoom[at]
     assert summary["cuts"] == [pytest.approx(1.0)]
+
+
+def test_the_rotations_file_marks_a_cut(two_shots, tmp_path):
+    # its row was a turn like any other's, 1.7 degrees of no camera's motion
+    from typer.testing import CliRunner
+
+    from stabilize.cli import app
+
+    out = tmp_path / "rot.csv"
+    result = CliRunner().invoke(app, ["rotations", str(two_shots), "-o", str(out), "--fov", "70"])
+    assert result.exit_code == 0, result.output
+    assert "a cut (a change of shot) at 1.00 s: marked in the rotations' cut column" in (
+        result.output
+    )
+    with open(out) as f:
+        marked = [int(row["frame"]) for row in csv.DictReader(f) if row["cut"] == "1"]
+    assert marked == [29]  # frames 29 -> 30, at 1.00 s
 
 
 def test_a_clip_of_one_shot_has_no_cut(tmp_path):
