@@ -33,7 +33,7 @@ from rotation import so3
 from rotation.camera import intrinsics
 from rotation.hough import warm_up
 from stabilize.gyro.log import GyroLog
-from stabilize.motion.cuts import cut_pairs, said_cuts
+from stabilize.motion.cuts import said_cuts, track_cuts
 from stabilize.motion.estimate import READOUT_BANDS, Damaged
 from stabilize.motion.focal import FocalChoice, estimate_motion
 from stabilize.motion.repair import repair_unreliable
@@ -545,9 +545,7 @@ def _rotations(
 
 def _cuts(track: VisualTrack, tell: Callable[[str], None]) -> NDArray[np.bool_]:
     """The track's cuts (changes of shot, :mod:`stabilize.motion.cuts`), said."""
-    if track.likeness is None:
-        return np.zeros(len(track.support), bool)
-    cuts = cut_pairs(track.likeness, track.support)
+    cuts = track_cuts(track)
     times = track.times[1:][cuts]  # the first frame of each new shot
     planned = "and each shot is planned on its own"
     if len(times) == 1:

@@ -62,7 +62,7 @@ def rotations(
     upright records, is read unturned)."""
     from rotation import so3
     from stabilize.cli.bars import with_bars
-    from stabilize.motion.cuts import cut_pairs, said_cuts
+    from stabilize.motion.cuts import said_cuts, track_cuts
     from stabilize.motion.estimate import Damaged
     from stabilize.motion.files import write_rotations
     from stabilize.motion.focal import estimate_motion
@@ -108,8 +108,8 @@ def rotations(
     track, focal = run_or_fail(lambda: with_bars(estimate, quiet=quiet))
     across = f"{focal.fov_deg:.1f}° across the long side"
     notice(f"focal length {focal.px:.1f} px ({across}, {focal.source})")
-    cuts = None if track.likeness is None else cut_pairs(track.likeness, track.support)
-    if cuts is not None and cuts.any():  # their rows are no camera's turn
+    cuts = track_cuts(track)
+    if cuts.any():  # their rows are no camera's turn
         notice(f"{said_cuts(track.times[1:][cuts])}: marked in the rotations' cut column")
 
     def write(target: Path, writer) -> None:

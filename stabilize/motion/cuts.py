@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from stabilize.motion.repair import MIN_SUPPORT
+from stabilize.motion.track import VisualTrack
 
 THUMBNAIL_WIDTH = 96  # px: the thumbnails compared
 BLUR_PX = 0.75  # Gaussian σ of the thumbnails, px: noise and compression blocks do not count
@@ -98,6 +99,14 @@ def said_cuts(times: NDArray) -> str:
         return f"a cut (a change of shot) at {at}"
     more = f" and {len(times) - SAID} more" if len(times) > SAID else ""
     return f"{len(times)} cuts (changes of shot) at {at}{more}"
+
+
+def track_cuts(track: VisualTrack) -> NDArray[np.bool_]:
+    """The cut pairs of a pass-1 track (:func:`cut_pairs`); none where its pictures'
+    likeness was not measured."""
+    if track.likeness is None:
+        return np.zeros(len(track.support), bool)
+    return cut_pairs(track.likeness, track.support)
 
 
 def cut_pairs(likenesses: NDArray, support: NDArray) -> NDArray[np.bool_]:
