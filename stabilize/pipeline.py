@@ -20,7 +20,6 @@ import os
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, replace
-from functools import partial
 from pathlib import Path
 from threading import Thread
 from typing import TYPE_CHECKING
@@ -36,7 +35,7 @@ from stabilize.gyro.log import GyroLog
 from stabilize.motion.cuts import said_cuts, track_cuts
 from stabilize.motion.estimate import READOUT_BANDS, Damaged
 from stabilize.motion.focal import FocalChoice, estimate_motion
-from stabilize.motion.repair import repair_unreliable
+from stabilize.motion.repair import repair_track
 from stabilize.motion.residual import reexpress
 from stabilize.motion.track import VisualTrack
 from stabilize.path.plan import plan_path
@@ -503,13 +502,8 @@ def _rotations(
     if from_gyro is not None:
         R, rolling, summary = from_gyro
     else:
-        samples = track.samples
-        agreeing = refined = None
-        if samples is not None:
-            agreeing = partial(samples.agreeing, focal=focal)
-            refined = partial(samples.refined, focal=focal)
         cuts = _cuts(track, tell)
-        R, reliable = repair_unreliable(track.rotations, track.support, agreeing, refined, cuts)
+        R, reliable = repair_track(track, focal, cuts)
         rolling, summary = None, None
         from stabilize.shutter import readout_for, visual_rolling_shutter
 

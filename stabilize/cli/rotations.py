@@ -45,7 +45,8 @@ def rotations(
     gcsv: Path | None = typer.Option(
         None,
         help="Also (or only) write the rates as a Gyroflow .gcsv, for clips with no gyro "
-        "('-': standard output).",
+        "('-': standard output): the turns the stabiliser follows, a cut's and an "
+        "unreliable pair's taken from the pairs beside it.",
     ),
     flow_name: FlowOption = DEFAULTS.flow,
     raft_weights: RaftWeightsOption = None,
@@ -94,14 +95,24 @@ def rotations(
     # 0.015° a pair further from the truth (tests/stabilize/warp/test_lens.py)
     camera = run_or_fail(lambda: read_lens_profile(lens, info.size)) if lens else None
 
+    keep = gcsv is not None  # its flow vectors check each jump the repair would mend
+
     def estimate(bar):
         try:
-            return estimate_motion(input_path, info, settings, bar("estimating", None), lens=camera)
+            return estimate_motion(
+                input_path, info, settings, bar("estimating", None), lens=camera, keep_samples=keep
+            )
         except Damaged as damage:  # the frames that decode, each at its own time
             times = damage.frames_that_decode(info)
             notice(damage.notice)
             return estimate_motion(
-                input_path, info, settings, bar("estimating", None), times, lens=camera
+                input_path,
+                info,
+                settings,
+                bar("estimating", None),
+                times,
+                lens=camera,
+                keep_samples=keep,
             )
 
     announce_compiling()
@@ -126,5 +137,14 @@ def rotations(
         write(output, lambda to: write_rotations(to, *rows))
     if gcsv is not None:
         from stabilize.gyro.export import write_gcsv
+        from stabilize.motion.repair import repair_track
 
-        write(gcsv, lambda to: write_gcsv(to, track.times, track.rotations))
+        # Gyroflow integrates every rate it is given: a cut's row, read as a turn, would
+        # turn the whole shot after it (5.6 degrees at a second of hero7 cut to karma, 70°)
+        R, reliable = repair_track(track, focal.px, cuts)
+        if not reliable.all():
+            notice(
+                f"{int((~reliable).sum())} of {len(reliable)} pairs' turns in the .gcsv are "
+                "taken from the pairs beside them (cuts, and pairs too few vectors agreed on)"
+            )
+        write(gcsv, lambda to: write_gcsv(to, track.times, R))

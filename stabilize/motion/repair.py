@@ -35,11 +35,13 @@ against (-8.5, 8.8), (-4.5, 1.3) and (-2.5, 2.1). The clip's residual shake went
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import partial
 
 import numpy as np
 from numpy.typing import NDArray
 
 from rotation import so3
+from stabilize.motion.track import VisualTrack
 
 MIN_SUPPORT = 0.03  # below this share of agreeing vectors a frame's rotation is a guess
 RELATIVE_SUPPORT = 0.35  # ...or below this fraction of the clip's median support
@@ -111,3 +113,17 @@ def repair_unreliable(
                 continue  # the flow follows the jump: a jolt
         out[k], reliable[k] = repair, False
     return so3.exp_so3(out), reliable
+
+
+def repair_track(
+    track: VisualTrack, focal: float, cuts: NDArray | None = None
+) -> tuple[NDArray, NDArray]:
+    """:func:`repair_unreliable` on a pass-1 track, its own flow vectors (where it kept
+    them) checking each jump at the focal length ``focal`` (px, full size): the turns
+    the stabiliser follows, before any rolling shutter's rows are dated."""
+    samples = track.samples
+    if samples is None:
+        return repair_unreliable(track.rotations, track.support, cuts=cuts)
+    agreeing = partial(samples.agreeing, focal=focal)
+    refined = partial(samples.refined, focal=focal)
+    return repair_unreliable(track.rotations, track.support, agreeing, refined, cuts)

@@ -97,6 +97,22 @@ def test_the_rotations_file_marks_a_cut(two_shots, tmp_path):
     assert marked == [29]  # frames 29 -> 30, at 1.00 s
 
 
+def test_gyroflow_is_given_no_turn_across_a_cut(two_shots, tmp_path):
+    # Gyroflow integrates each rate: the cut's row, 5.6 degrees, would turn karma's shot
+    from typer.testing import CliRunner
+
+    from stabilize.cli import app
+    from stabilize.gyro.readers import read_gcsv
+
+    out = tmp_path / "visual.gcsv"
+    args = ["rotations", str(two_shots), "--gcsv", str(out), "--fov", "70"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert "pairs' turns in the .gcsv are taken from the pairs beside them" in result.output
+    speed = np.linalg.norm(read_gcsv(out).rates, axis=1)
+    assert speed[29] <= np.percentile(np.delete(speed, 29), 90)  # frames 29 -> 30
+
+
 def test_a_clip_of_one_shot_has_no_cut(tmp_path):
     summary, _ = stabilize_video(SAMPLE / "clip.mp4", tmp_path / "out.mp4", Settings(fov=70.0))
     assert not any("change of shot" in n for n in summary["notices"])
