@@ -32,7 +32,7 @@ from rotation import so3
 from rotation.camera import intrinsics
 from rotation.hough import warm_up
 from stabilize.gyro.log import GyroLog
-from stabilize.motion.cuts import said_cuts, track_cuts
+from stabilize.motion.cuts import Breaks, said_cuts, track_breaks
 from stabilize.motion.estimate import READOUT_BANDS, Damaged
 from stabilize.motion.focal import FocalChoice, estimate_motion
 from stabilize.motion.repair import repair_track
@@ -502,12 +502,13 @@ def _rotations(
     if from_gyro is not None:
         R, rolling, summary = from_gyro
     else:
-        cuts = _cuts(track, tell)
-        R, reliable = repair_track(track, focal, cuts)
+        breaks = _breaks(track, tell)
+        cuts = breaks.cuts
+        R, reliable = repair_track(track, focal, breaks.unrelated)
         rolling, summary = None, None
         from stabilize.shutter import readout_for, visual_rolling_shutter
 
-        shutter, spline = readout_for(settings.rolling_shutter, track)
+        shutter, spline = readout_for(settings.rolling_shutter, track, ~reliable)
         if shutter is not None and shutter.source != "off":
             tell(f"rolling shutter: {shutter.describe()}")
         if spline is not None:
@@ -537,16 +538,16 @@ def _rotations(
     return Turns(R, rolling, residual, int((~reliable).sum()), summary, shutter, eased, cuts)
 
 
-def _cuts(track: VisualTrack, tell: Callable[[str], None]) -> NDArray[np.bool_]:
-    """The track's cuts (changes of shot, :mod:`stabilize.motion.cuts`), said."""
-    cuts = track_cuts(track)
-    times = track.times[1:][cuts]  # the first frame of each new shot
+def _breaks(track: VisualTrack, tell: Callable[[str], None]) -> Breaks:
+    """The track's breaks (:mod:`stabilize.motion.cuts`), its cuts said."""
+    breaks = track_breaks(track)
+    times = track.times[1:][breaks.cuts]  # the first frame of each new shot
     planned = "and each shot is planned on its own"
     if len(times) == 1:
         tell(f"{said_cuts(times)}: its turn is taken from the frames beside it, {planned}")
     elif len(times):
         tell(f"{said_cuts(times)}: their turns are taken from the frames beside them, {planned}")
-    return cuts
+    return breaks
 
 
 def _gyro_rotations(

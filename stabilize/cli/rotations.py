@@ -63,7 +63,7 @@ def rotations(
     upright records, is read unturned)."""
     from rotation import so3
     from stabilize.cli.bars import with_bars
-    from stabilize.motion.cuts import said_cuts, track_cuts
+    from stabilize.motion.cuts import said_cuts, track_breaks
     from stabilize.motion.estimate import Damaged
     from stabilize.motion.files import write_rotations
     from stabilize.motion.focal import estimate_motion
@@ -119,7 +119,8 @@ def rotations(
     track, focal = run_or_fail(lambda: with_bars(estimate, quiet=quiet))
     across = f"{focal.fov_deg:.1f}° across the long side"
     notice(f"focal length {focal.px:.1f} px ({across}, {focal.source})")
-    cuts = track_cuts(track)
+    breaks = track_breaks(track)
+    cuts = breaks.cuts
     if cuts.any():  # their rows are no camera's turn
         notice(f"{said_cuts(track.times[1:][cuts])}: marked in the rotations' cut column")
 
@@ -141,10 +142,11 @@ def rotations(
 
         # Gyroflow integrates every rate it is given: a cut's row, read as a turn, would
         # turn the whole shot after it (5.6 degrees at a second of hero7 cut to karma, 70°)
-        R, reliable = repair_track(track, focal.px, cuts)
+        R, reliable = repair_track(track, focal.px, breaks.unrelated)
         if not reliable.all():
             notice(
                 f"{int((~reliable).sum())} of {len(reliable)} pairs' turns in the .gcsv are "
-                "taken from the pairs beside them (cuts, and pairs too few vectors agreed on)"
+                "taken from the pairs beside them (cuts, interruptions, and pairs too few "
+                "vectors agreed on)"
             )
         write(gcsv, lambda to: write_gcsv(to, track.times, R))

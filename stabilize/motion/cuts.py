@@ -31,9 +31,22 @@ with none of the flow agreeing). The 21 of those 360 cuts that read over 0.6 rea
 over 14 (cockatoo's, at 0.908, with 3.7% of its flow agreeing), and of the pairs under
 3%, over 8.2, nor any alone in their views at 640 px, zoomed in two or three times, at
 half the frame rate or compressed at CRF 32.
+
+A shot that resumes is not cut: a black frame dropped into karma's flight read two cuts,
+into it and out of it, and three frames of hero7's walk with a hand across 70% of the
+lens read one as the hand left; each shot was planned on its own, so the walk's zoom
+jumped from 1.149 to 1.054 between two frames of one view. Where a pair looks unlike, its
+later frame is compared with the ``RESUME`` frames before the pair's first, and where it
+looks alike to one of them (``ALIKE`` or more), the pairs between are an interruption
+(a flash, a dropped frame, something passing across the lens), not a cut; their turns
+are repaired as any pair's too few vectors agreed on (:mod:`stabilize.motion.repair`).
+Two shots of one place stay cut: karma's first second cut to its fourth reads 0.906.
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -50,6 +63,12 @@ ALIKE = 0.95  # ... and under which they may be a cut, far less alike than their
 DROP = 25.0  # ... by this many times the median unlikeness of the NEIGHBOURS pairs each side
 NEIGHBOURS = 8
 ALONE = 0.25  # ... and alone: each pair beside it under this share of its unlikeness
+# frames: the longest interruption a shot resumes after (0.27 s at 30 fps), each unlike
+# pair's later frame compared with at most this many more. Frames of one shot look less
+# alike further apart (at least: hero7's walk 0.964 four frames apart, 0.908 nine;
+# karma 0.987, 0.959; phone-cc9's drive 0.930, 0.848), so a moving shot resumes ALIKE
+# only after a shorter interruption
+RESUME = 8
 
 
 def thumbnail(frame: NDArray) -> NDArray[np.float32]:
@@ -82,6 +101,39 @@ def likeness(a: NDArray[np.float32], b: NDArray[np.float32]) -> float:
     return best
 
 
+def resumes(recent: Sequence[NDArray[np.float32]], after: NDArray[np.float32]) -> int:
+    """How far back, beyond the frame just before it (the last of the ``recent``
+    thumbnails, oldest first), the thumbnail ``after`` finds the farthest picture it looks
+    alike to (``ALIKE`` or more): 2 where it is the frame two before; 0 where none is.
+
+    >>> rng = np.random.default_rng(0)
+    >>> view = cv2.GaussianBlur(rng.random((54, 96), np.float32), (0, 0), 2.0)
+    >>> black = np.zeros_like(view)
+    >>> resumes([view, view, black], view)  # a black frame between
+    3
+    >>> resumes([view, black], rng.random((54, 96), np.float32))  # another picture
+    0
+    """
+    for back in range(len(recent), 1, -1):
+        if likeness(recent[-back], after) >= ALIKE:
+            return back
+    return 0
+
+
+def interrupted(resumes: NDArray) -> NDArray[np.bool_]:
+    """The pairs an interruption spans: for each pair k whose later frame resumes a
+    picture ``resumes[k]`` frames back, the pairs from that frame's to k.
+
+    >>> interrupted(np.array([0, 0, 0, 3, 0]))  # frame 4 looks as frame 1 did
+    array([False,  True,  True,  True, False])
+    """
+    spans = np.zeros(len(resumes) + 1, np.int64)
+    for k in np.flatnonzero(resumes):
+        spans[k + 1 - resumes[k]] += 1
+        spans[k + 1] -= 1
+    return np.cumsum(spans)[:-1] > 0
+
+
 SAID = 10  # the cuts a notice names by their times
 
 
@@ -101,23 +153,37 @@ def said_cuts(times: NDArray) -> str:
     return f"{len(times)} cuts (changes of shot) at {at}{more}"
 
 
-def track_cuts(track: VisualTrack) -> NDArray[np.bool_]:
-    """The cut pairs of a pass-1 track (:func:`cut_pairs`); none where its pictures'
-    likeness was not measured."""
+@dataclass(frozen=True)
+class Breaks:
+    """Where a track's pictures break. ``unrelated``: the pairs whose frames look
+    unrelated and whose flow agrees on nothing (:func:`unrelated_pairs`), so no turn is
+    read across them; ``cuts``: those of them where the shot changes rather than resumes
+    (:func:`interrupted`), after which the path is planned anew."""
+
+    unrelated: NDArray[np.bool_]
+    cuts: NDArray[np.bool_]
+
+
+def track_breaks(track: VisualTrack) -> Breaks:
+    """A pass-1 track's :class:`Breaks`; none where its pictures' likeness was not
+    measured."""
     if track.likeness is None:
-        return np.zeros(len(track.support), bool)
-    return cut_pairs(track.likeness, track.support)
+        none = np.zeros(len(track.support), bool)
+        return Breaks(none, none)
+    unrelated = unrelated_pairs(track.likeness, track.support)
+    resumed = np.zeros_like(unrelated) if track.resumes is None else interrupted(track.resumes)
+    return Breaks(unrelated, unrelated & ~resumed)
 
 
-def cut_pairs(likenesses: NDArray, support: NDArray) -> NDArray[np.bool_]:
-    """Which frame pairs are cuts: under ``MIN_SUPPORT`` of the flow agrees on any
-    rotation, and their frames look alike nowhere (``likenesses`` under ``LIKENESS``),
-    or far less alike than the pairs around them (:func:`drops`).
+def unrelated_pairs(likenesses: NDArray, support: NDArray) -> NDArray[np.bool_]:
+    """Which frame pairs see unrelated pictures: under ``MIN_SUPPORT`` of the flow
+    agrees on any rotation, and their frames look alike nowhere (``likenesses`` under
+    ``LIKENESS``), or far less alike than the pairs around them (:func:`drops`).
 
     >>> alike = np.array([0.999, 0.998, 0.999, 0.91, 0.999, 0.997, 0.4])
-    >>> cut_pairs(alike, np.full(7, 0.01))  # 0.91: 90 times its neighbours' unlikeness
+    >>> unrelated_pairs(alike, np.full(7, 0.01))  # 0.91: 90 times its neighbours' unlikeness
     array([False, False, False,  True, False, False,  True])
-    >>> cut_pairs(alike, np.full(7, 0.2))  # but most of the flow agrees on a turn
+    >>> unrelated_pairs(alike, np.full(7, 0.2))  # but most of the flow agrees on a turn
     array([False, False, False, False, False, False, False])
     """
     likenesses = np.asarray(likenesses, dtype=np.float64)

@@ -37,7 +37,7 @@ from flow.texture import textured
 from rotation import HoughEstimator
 from rotation.camera import scale_intrinsics
 from rotation.sampling import SampleGrid
-from stabilize.motion.cuts import likeness, thumbnail
+from stabilize.motion.cuts import ALIKE, RESUME, likeness, resumes, thumbnail
 from stabilize.motion.residual import residual_motion
 from stabilize.motion.track import Samples, VisualTrack, mean_rows
 from stabilize.progress import Progress, no_progress
@@ -89,7 +89,9 @@ def estimate_rotations(
     masks = band_masks(estimator, ws.size[0], voted)
     textures: deque[NDArray] = deque()  # each frame's measurable vectors, until its pair
     likenesses: list[float] = []  # each pair's (cuts.likeness)
-    noted = _noting_texture(_noting_likeness(frames, likenesses), estimator.grid, textures)
+    resumed: list[int] = []  # ... and, where unlike, how far back its picture resumes
+    pictures = _noting_likeness(frames, likenesses, resumed)
+    noted = _noting_texture(pictures, estimator.grid, textures)
     # A chunk's vote runs while the next chunk's flow is computed: without the overlap,
     # pass 1 used 1.65 of this machine's 2 cores (1080p, 10 s, with the bands' votes
     # below: 7.8 s, 7.0 with it), when the flow kept one core busy; it now takes pairs
@@ -123,8 +125,14 @@ def estimate_rotations(
         times = times[:n] if len(times) > n else np.arange(n) / max(info.fps, 1.0)
     samples = _samples(kept, estimator, ws) if kept else None
     track = _track(times, found, voted)
-    alike = np.array(likenesses[: n - 1])
-    return replace(track, samples=samples, residual=np.concatenate(residual), likeness=alike)
+    alike, resumes = np.array(likenesses[: n - 1]), np.array(resumed[: n - 1], np.int64)
+    return replace(
+        track,
+        samples=samples,
+        residual=np.concatenate(residual),
+        likeness=alike,
+        resumes=resumes,
+    )
 
 
 class Damaged(VideoError):
@@ -183,7 +191,11 @@ def estimate_again(estimator: HoughEstimator, track: VisualTrack, bands: int = 0
     # the likeness once went missing here, so a clip whose focal length was estimated at
     # its end (any clip under MAX_PAIRS pairs) had no cut found
     return replace(
-        again, samples=track.samples, residual=np.concatenate(residual), likeness=track.likeness
+        again,
+        samples=track.samples,
+        residual=np.concatenate(residual),
+        likeness=track.likeness,
+        resumes=track.resumes,
     )
 
 
@@ -295,16 +307,21 @@ def _noting_texture(
         yield frame
 
 
-def _noting_likeness(frames: Iterator[NDArray], likenesses: list[float]) -> Iterator[NDArray]:
+def _noting_likeness(
+    frames: Iterator[NDArray], likenesses: list[float], resumed: list[int]
+) -> Iterator[NDArray]:
     """The frames as they are, noting in ``likenesses`` how alike each looks to the one
     before (:func:`stabilize.motion.cuts.likeness`: about 0.2 ms a pair, with the
-    thumbnails)."""
-    before = None
+    thumbnails), and in ``resumed``, where they look unlike, how far back it finds a
+    picture it looks alike to (:func:`stabilize.motion.cuts.resumes`; 0 elsewhere)."""
+    recent: deque[NDArray] = deque(maxlen=RESUME + 1)
     for frame in frames:
         small = thumbnail(frame)
-        if before is not None:
-            likenesses.append(likeness(before, small))
-        before = small
+        if recent:
+            alike = likeness(recent[-1], small)
+            likenesses.append(alike)
+            resumed.append(resumes(recent, small) if alike < ALIKE else 0)
+        recent.append(small)
         yield frame
 
 

@@ -58,7 +58,7 @@ def repair_unreliable(
     support: NDArray,
     agreeing: Callable[[int, NDArray], int] | None = None,
     refined: Callable[[int, NDArray], NDArray] | None = None,
-    cuts: NDArray | None = None,
+    unrelated: NDArray | None = None,
 ) -> tuple[NDArray, NDArray]:
     """Replace the rotations R (N-1, 3, 3) whose ``support`` is too low and that jump
     away from their neighbours', unless ``agreeing(k, R)``, how many of pair k's flow
@@ -67,14 +67,15 @@ def repair_unreliable(
     the neighbours' mean, where more of them agree with it than with the mean; else the
     mean.
 
-    A pair that ``cuts`` marks (a change of shot, :mod:`stabilize.motion.cuts`) is the
-    neighbours' mean whatever its vectors say: they see two unrelated pictures.
+    A pair marked ``unrelated`` (a cut, or a shot interrupted: a black frame, a flash,
+    a hand across the lens; :mod:`stabilize.motion.cuts`) is the neighbours' mean
+    whatever its vectors say: they see two unrelated pictures.
 
     Returns (R, reliable mask); all frames count as reliable when none, or all, are
-    short of support, cuts aside.
+    short of support, unrelated pairs aside.
     """
     support = np.asarray(support)
-    cuts = np.zeros(len(R), bool) if cuts is None else np.asarray(cuts, bool)
+    cuts = np.zeros(len(R), bool) if unrelated is None else np.asarray(unrelated, bool)
     supported = support >= max(MIN_SUPPORT, RELATIVE_SUPPORT * float(np.median(support)))
     # short of support, where support tells pairs apart (some have it, some do not)
     doubtful = ~supported if supported.any() else np.zeros(len(R), bool)
@@ -116,14 +117,14 @@ def repair_unreliable(
 
 
 def repair_track(
-    track: VisualTrack, focal: float, cuts: NDArray | None = None
+    track: VisualTrack, focal: float, unrelated: NDArray | None = None
 ) -> tuple[NDArray, NDArray]:
     """:func:`repair_unreliable` on a pass-1 track, its own flow vectors (where it kept
     them) checking each jump at the focal length ``focal`` (px, full size): the turns
     the stabiliser follows, before any rolling shutter's rows are dated."""
     samples = track.samples
     if samples is None:
-        return repair_unreliable(track.rotations, track.support, cuts=cuts)
+        return repair_unreliable(track.rotations, track.support, unrelated=unrelated)
     agreeing = partial(samples.agreeing, focal=focal)
     refined = partial(samples.refined, focal=focal)
-    return repair_unreliable(track.rotations, track.support, agreeing, refined, cuts)
+    return repair_unreliable(track.rotations, track.support, agreeing, refined, unrelated)

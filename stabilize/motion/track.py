@@ -98,6 +98,9 @@ class VisualTrack:
     residual: NDArray[np.float64] | None = None
     # (N-1,) how alike each pair's frames look, 1 the same picture (:mod:`.cuts`)
     likeness: NDArray[np.float64] | None = None
+    # (N-1,) of a pair whose frames look unlike, how far back its later frame finds a
+    # picture it looks alike to: the shot resumed after an interruption (:mod:`.cuts`)
+    resumes: NDArray[np.int64] | None = None
 
     @classmethod
     def from_rotations(cls, times: NDArray, rotations: NDArray) -> VisualTrack:
@@ -120,6 +123,7 @@ class VisualTrack:
             None if self.samples is None else self.samples.pairs(first, stop),
             None if self.residual is None else self.residual[first:stop],
             None if self.likeness is None else self.likeness[first:stop],
+            None if self.resumes is None else self.resumes[first:stop],
         )
 
 

@@ -13,7 +13,7 @@ import pytest
 
 from rotation import so3
 from stabilize import Settings, stabilize_video
-from stabilize.motion.cuts import LIKENESS, cut_pairs, likeness, thumbnail
+from stabilize.motion.cuts import LIKENESS, likeness, thumbnail, unrelated_pairs
 from stabilize.video import ffmpeg_exe, read_frames
 from tests.stabilize.helpers import SAMPLE
 
@@ -30,7 +30,7 @@ def test_a_turned_or_brightened_picture_looks_alike_and_another_does_not():
 
 def test_a_cut_needs_both_an_unlike_picture_and_no_agreement():
     alike, support = np.array([0.9, 0.3, 0.3, 0.9]), np.array([0.01, 0.2, 0.01, 0.2])
-    np.testing.assert_array_equal(cut_pairs(alike, support), [False, False, True, False])
+    np.testing.assert_array_equal(unrelated_pairs(alike, support), [False, False, True, False])
 
 
 def edited(out: Path, *shots: tuple[Path, float]) -> Path:
@@ -51,9 +51,9 @@ def test_a_run_of_unlike_pairs_is_a_subject_sweeping_past_not_a_cut():
     # three pairs in a row read 36-130 times their neighbours' unlikeness
     calm = [0.999, 0.998, 0.999, 0.997, 0.999, 0.998, 0.999, 0.999]
     sweep = np.array([*calm, 0.721, 0.84, 0.719, *calm])
-    assert not cut_pairs(sweep, np.zeros(len(sweep))).any()
+    assert not unrelated_pairs(sweep, np.zeros(len(sweep))).any()
     once = np.array([*calm, 0.84, *calm])  # the same drop, alone: a cut
-    np.testing.assert_array_equal(np.flatnonzero(cut_pairs(once, np.zeros(len(once)))), [8])
+    np.testing.assert_array_equal(np.flatnonzero(unrelated_pairs(once, np.zeros(len(once)))), [8])
 
 
 @pytest.fixture(scope="module")
@@ -129,9 +129,35 @@ def test_a_cut_between_two_shots_of_one_place_is_found(shared, tmp_path):
     assert path.shots == (0, 30)
 
 
+@pytest.mark.parametrize(
+    "interruption",
+    [
+        "eq=brightness=-1:enable='eq(n,30)'",  # a black frame: read as two cuts
+        "eq=brightness=-1:enable='between(n,30,32)'",  # three
+        "eq=brightness=1:enable='eq(n,30)'",  # a white one (a flash that blinds)
+    ],
+)
+def test_a_shot_that_resumes_after_an_interruption_is_not_cut(shared, tmp_path, interruption):
+    from stabilize.motion.cuts import track_breaks
+    from stabilize.motion.estimate import estimate_rotations
+    from stabilize.video import probe
+
+    hero7 = shared / "data" / "gopro" / "hero7.mp4"
+    clip = tmp_path / "interrupted.mp4"
+    graph = f"scale=424:240,{interruption}"
+    cmd = [ffmpeg_exe(), "-v", "error", "-t", "2", "-i", str(hero7), "-vf", graph, "-an"]
+    subprocess.run([*cmd, "-c:v", "libx264", "-crf", "16", str(clip)], check=True)
+    track = estimate_rotations(clip, probe(clip), Settings(fov=70.0))
+    breaks = track_breaks(track)
+    assert breaks.unrelated.any() and not breaks.cuts.any()
+    summary, path = stabilize_video(clip, tmp_path / "out.mp4", Settings(fov=70.0))
+    assert summary["cuts"] == [] and path.shots == (0,)
+    assert np.ptp(path.zoom) == 0  # one zoom for the one shot
+
+
 def test_a_montage_is_said_in_one_line_naming_its_first_ten_cuts():
     from stabilize.motion.track import VisualTrack
-    from stabilize.pipeline import _cuts
+    from stabilize.pipeline import _breaks
 
     n = 60
     alike = np.full(n, 0.99)
@@ -139,7 +165,7 @@ def test_a_montage_is_said_in_one_line_naming_its_first_ten_cuts():
     track = VisualTrack.from_rotations(np.arange(n + 1) / 30, np.repeat(np.eye(3)[None], n, 0))
     track = replace(track, support=np.full(n, 0.01), likeness=alike)
     said: list[str] = []
-    assert _cuts(track, said.append).sum() == 12
+    assert _breaks(track, said.append).cuts.sum() == 12
     assert said == [
         "12 cuts (changes of shot) at 0.17 s, 0.33 s, 0.50 s, 0.67 s, 0.83 s, 1.00 s, 1.17 s, "
         "1.33 s, 1.50 s, 1.67 s and 2 more: their turns are taken from the frames beside them, "

@@ -77,3 +77,28 @@ def test_a_long_clip_is_searched_on_its_most_shaking_stretch(monkeypatch):
     found, spline = readout.estimate_readout(track)
     assert found.seconds == pytest.approx(0.025, abs=1e-3)
     assert spline.knots[-1] > track.times[-1]  # the attitude spans the whole clip
+
+
+def test_the_attitude_is_not_fitted_to_repaired_pairs():
+    # two pairs whose every band read a turn of no camera (a black frame, a cut): their
+    # turns were repaired, but the attitude followed their bands, and the rows' turns
+    # it gives replaced the repair
+    from rotation import so3
+    from stabilize.shutter.rows import visual_rolling_shutter
+
+    track, _ = banded_track(0.025, seed=25)
+    junk = so3.exp_so3(np.radians([2.0, -1.0, 0.0])[None])[0]
+    rotations, bands = track.rotations.copy(), track.bands.copy()
+    rotations[40:42], bands[:, 40:42] = junk, junk
+    bad = replace(track, rotations=rotations, bands=bands)
+    repaired = np.zeros(len(rotations), bool)
+    repaired[40:42] = True
+
+    def off_deg(pairs: np.ndarray | None) -> np.ndarray:
+        readout, spline = readout_for("25", bad, pairs)
+        R, _ = visual_rolling_shutter(spline, bad.times, readout.seconds, 1080)
+        apart = R[40:42] @ np.swapaxes(track.rotations[40:42], 1, 2)
+        return np.degrees(so3.angle(apart))
+
+    assert (off_deg(None) > 2.5).all()  # 2.9 and 3.3 degrees: the junk followed
+    assert (off_deg(repaired) < 0.7).all()  # 0.44 and 0.59: bridged by its neighbours
