@@ -59,6 +59,10 @@ THUMBNAIL_WIDTH = 96  # px: the thumbnails compared
 BLUR_PX = 0.75  # Gaussian σ of the thumbnails, px: noise and compression blocks do not count
 SHIFT = 0.16  # of each thumbnail's width and height, each way, its middle shifts over the other
 LIKENESS = 0.6  # the correlation under which two frames look alike nowhere
+# grey levels (of 255): a thumbnail's middle of less contrast is blank (a black frame, a
+# lens cap's noise), and two blank ones look alike, where every pair of a black clip was
+# a cut; the real clips' frames read 23-67
+BLANK = 1.0
 ALIKE = 0.95  # ... and under which they may be a cut, far less alike than their neighbours
 DROP = 25.0  # ... by this many times the median unlikeness of the NEIGHBOURS pairs each side
 NEIGHBOURS = 8
@@ -85,18 +89,24 @@ def likeness(a: NDArray[np.float32], b: NDArray[np.float32]) -> float:
     middle over the other, shifted by up to ``SHIFT`` each way (1: the same picture, moved).
 
     >>> rng = np.random.default_rng(0)
-    >>> picture = cv2.GaussianBlur(rng.random((72, 160), np.float32), (0, 0), 2.0)
+    >>> picture = cv2.GaussianBlur(255 * rng.random((72, 160), np.float32), (0, 0), 2.0)
     >>> round(likeness(picture[:, :96], picture[:, 10:106]), 3)  # turned 10 px
     1.0
-    >>> likeness(picture[:, :96], rng.random((72, 96), np.float32)) < LIKENESS
+    >>> likeness(picture[:, :96], 255 * rng.random((72, 96), np.float32)) < LIKENESS
     True
+    >>> black = np.full((72, 96), 16, np.float32)
+    >>> likeness(black, black + rng.normal(0, 0.5, black.shape).astype(np.float32))
+    1.0
     """
     h, w = a.shape
     dy, dx = round(h * SHIFT), round(w * SHIFT)
+    middles = [one[dy : h - dy, dx : w - dx] for one in (a, b)]
+    blank = [float(middle.std()) <= BLANK for middle in middles]
+    if all(blank):  # nothing to tell them apart: no change of picture
+        return 1.0
     best = -1.0
-    for one, other in ((a, b), (b, a)):
-        middle = one[dy : h - dy, dx : w - dx]
-        if middle.std() > 1e-6:  # a flat picture matches nothing
+    for middle, other, flat in ((middles[0], b, blank[0]), (middles[1], a, blank[1])):
+        if not flat:  # a blank picture matches nothing
             best = max(best, float(cv2.matchTemplate(other, middle, cv2.TM_CCOEFF_NORMED).max()))
     return best
 
@@ -107,11 +117,11 @@ def resumes(recent: Sequence[NDArray[np.float32]], after: NDArray[np.float32]) -
     alike to (``ALIKE`` or more): 2 where it is the frame two before; 0 where none is.
 
     >>> rng = np.random.default_rng(0)
-    >>> view = cv2.GaussianBlur(rng.random((54, 96), np.float32), (0, 0), 2.0)
+    >>> view = cv2.GaussianBlur(255 * rng.random((54, 96), np.float32), (0, 0), 2.0)
     >>> black = np.zeros_like(view)
     >>> resumes([view, view, black], view)  # a black frame between
     3
-    >>> resumes([view, black], rng.random((54, 96), np.float32))  # another picture
+    >>> resumes([view, black], 255 * rng.random((54, 96), np.float32))  # another picture
     0
     """
     for back in range(len(recent), 1, -1):

@@ -155,6 +155,17 @@ def test_a_shot_that_resumes_after_an_interruption_is_not_cut(shared, tmp_path, 
     assert np.ptp(path.zoom) == 0  # one zoom for the one shot
 
 
+def test_black_frames_are_one_picture_not_a_cut_each(shared, tmp_path):
+    # a second of black (a lens cap, a camera's first frames) read 29 cuts among itself
+    black = tmp_path / "black.mp4"
+    lavfi = ["-f", "lavfi", "-i", "color=black:s=424x240:d=1:r=30", "-pix_fmt", "yuv420p"]
+    subprocess.run([ffmpeg_exe(), "-v", "error", *lavfi, str(black)], check=True)
+    hero7 = shared / "data" / "gopro" / "hero7.mp4"
+    clip = edited(tmp_path / "opening.mp4", (black, 0.0), (hero7, 0.0))
+    summary, _ = stabilize_video(clip, tmp_path / "out.mp4", Settings(fov=70.0))
+    assert summary["cuts"] == [pytest.approx(1.0)]  # where the picture begins
+
+
 def test_a_montage_is_said_in_one_line_naming_its_first_ten_cuts():
     from stabilize.motion.track import VisualTrack
     from stabilize.pipeline import _breaks
