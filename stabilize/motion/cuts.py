@@ -38,9 +38,10 @@ lens read one as the hand left; each shot was planned on its own, so the walk's 
 jumped from 1.149 to 1.054 between two frames of one view. Where a pair looks unlike, its
 later frame is compared with the ``RESUME`` frames before the pair's first, and where it
 looks alike to one of them (``ALIKE`` or more), the pairs between are an interruption
-(a flash, a dropped frame, something passing across the lens), not a cut; their turns
-are repaired as any pair's too few vectors agreed on (:mod:`stabilize.motion.repair`).
-Two shots of one place stay cut: karma's first second cut to its fourth reads 0.906.
+(a flash, a dropped frame, something passing across the lens), not a cut: their turns
+are their neighbours' mean, as a cut's (:mod:`stabilize.motion.repair`), but the path
+goes on through them. Two shots of one place stay cut: karma's first second cut to its
+fourth reads 0.906.
 """
 
 from __future__ import annotations
@@ -111,7 +112,7 @@ def likeness(a: NDArray[np.float32], b: NDArray[np.float32]) -> float:
     return best
 
 
-def resumes(recent: Sequence[NDArray[np.float32]], after: NDArray[np.float32]) -> int:
+def resumes_from(recent: Sequence[NDArray[np.float32]], after: NDArray[np.float32]) -> int:
     """How far back, beyond the frame just before it (the last of the ``recent``
     thumbnails, oldest first), the thumbnail ``after`` finds the farthest picture it looks
     alike to (``ALIKE`` or more): 2 where it is the frame two before; 0 where none is.
@@ -119,9 +120,9 @@ def resumes(recent: Sequence[NDArray[np.float32]], after: NDArray[np.float32]) -
     >>> rng = np.random.default_rng(0)
     >>> view = cv2.GaussianBlur(255 * rng.random((54, 96), np.float32), (0, 0), 2.0)
     >>> black = np.zeros_like(view)
-    >>> resumes([view, view, black], view)  # a black frame between
+    >>> resumes_from([view, view, black], view)  # a black frame between
     3
-    >>> resumes([view, black], 255 * rng.random((54, 96), np.float32))  # another picture
+    >>> resumes_from([view, black], 255 * rng.random((54, 96), np.float32))  # another picture
     0
     """
     for back in range(len(recent), 1, -1):
@@ -130,16 +131,17 @@ def resumes(recent: Sequence[NDArray[np.float32]], after: NDArray[np.float32]) -
     return 0
 
 
-def interrupted(resumes: NDArray) -> NDArray[np.bool_]:
+def interrupted(back: NDArray) -> NDArray[np.bool_]:
     """The pairs an interruption spans: for each pair k whose later frame resumes a
-    picture ``resumes[k]`` frames back, the pairs from that frame's to k.
+    picture ``back[k]`` frames back (:func:`resumes_from`), the pairs from that frame's
+    to k.
 
     >>> interrupted(np.array([0, 0, 0, 3, 0]))  # frame 4 looks as frame 1 did
     array([False,  True,  True,  True, False])
     """
-    spans = np.zeros(len(resumes) + 1, np.int64)
-    for k in np.flatnonzero(resumes):
-        spans[k + 1 - resumes[k]] += 1
+    spans = np.zeros(len(back) + 1, np.int64)
+    for k in np.flatnonzero(back):
+        spans[k + 1 - back[k]] += 1
         spans[k + 1] -= 1
     return np.cumsum(spans)[:-1] > 0
 

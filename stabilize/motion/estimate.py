@@ -37,7 +37,7 @@ from flow.texture import textured
 from rotation import HoughEstimator
 from rotation.camera import scale_intrinsics
 from rotation.sampling import SampleGrid
-from stabilize.motion.cuts import ALIKE, RESUME, likeness, resumes, thumbnail
+from stabilize.motion.cuts import ALIKE, RESUME, likeness, resumes_from, thumbnail
 from stabilize.motion.residual import residual_motion
 from stabilize.motion.track import Samples, VisualTrack, mean_rows
 from stabilize.progress import Progress, no_progress
@@ -125,13 +125,12 @@ def estimate_rotations(
         times = times[:n] if len(times) > n else np.arange(n) / max(info.fps, 1.0)
     samples = _samples(kept, estimator, ws) if kept else None
     track = _track(times, found, voted)
-    alike, resumes = np.array(likenesses[: n - 1]), np.array(resumed[: n - 1], np.int64)
     return replace(
         track,
         samples=samples,
         residual=np.concatenate(residual),
-        likeness=alike,
-        resumes=resumes,
+        likeness=np.array(likenesses[: n - 1]),
+        resumes=np.array(resumed[: n - 1], np.int64),
     )
 
 
@@ -313,14 +312,14 @@ def _noting_likeness(
     """The frames as they are, noting in ``likenesses`` how alike each looks to the one
     before (:func:`stabilize.motion.cuts.likeness`: about 0.2 ms a pair, with the
     thumbnails), and in ``resumed``, where they look unlike, how far back it finds a
-    picture it looks alike to (:func:`stabilize.motion.cuts.resumes`; 0 elsewhere)."""
+    picture it looks alike to (:func:`stabilize.motion.cuts.resumes_from`; 0 elsewhere)."""
     recent: deque[NDArray] = deque(maxlen=RESUME + 1)
     for frame in frames:
         small = thumbnail(frame)
         if recent:
             alike = likeness(recent[-1], small)
             likenesses.append(alike)
-            resumed.append(resumes(recent, small) if alike < ALIKE else 0)
+            resumed.append(resumes_from(recent, small) if alike < ALIKE else 0)
         recent.append(small)
         yield frame
 

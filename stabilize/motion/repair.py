@@ -75,22 +75,22 @@ def repair_unreliable(
     short of support, unrelated pairs aside.
     """
     support = np.asarray(support)
-    cuts = np.zeros(len(R), bool) if unrelated is None else np.asarray(unrelated, bool)
+    blind = np.zeros(len(R), bool) if unrelated is None else np.asarray(unrelated, bool)
     supported = support >= max(MIN_SUPPORT, RELATIVE_SUPPORT * float(np.median(support)))
     # short of support, where support tells pairs apart (some have it, some do not)
     doubtful = ~supported if supported.any() else np.zeros(len(R), bool)
-    if not (doubtful.any() or cuts.any()) or cuts.all():
+    if not (doubtful.any() or blind.any()) or blind.all():
         return R, np.ones(len(R), bool)
     rotvecs = so3.log_so3(R)
-    good = np.flatnonzero(~doubtful & ~cuts)
+    good = np.flatnonzero(~doubtful & ~blind)
     out = rotvecs.copy()
     reliable = np.ones(len(R), bool)  # a frame is unreliable once it is repaired
-    for k in np.flatnonzero(doubtful | cuts):
+    for k in np.flatnonzero(doubtful | blind):
         near = good[np.abs(good - k) <= REPAIR_WINDOW]
         if near.size == 0:
             near = good[[np.argmin(np.abs(good - k))]]
         mean = rotvecs[near].mean(axis=0)
-        if cuts[k]:
+        if blind[k]:
             out[k], reliable[k] = mean, False
             continue
         spread = np.sqrt(np.mean(np.sum((rotvecs[near] - mean) ** 2, axis=1)))
