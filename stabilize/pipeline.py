@@ -164,7 +164,7 @@ def stabilize_video(
             tell(f"damaged: the first {lead:.2f} s of video do not decode: it starts there")
         track, focal, turns = _damaged_motion(src, job, settings, bar, tell, damage)
     t_estimate = time.perf_counter() - start
-    K = _camera_matrix(focal.px, job.info, job.lens)
+    K = _camera_matrices(focal, job.info, job.lens, len(track.times))
     planned = plan_path(
         track.times,
         turns.R,
@@ -201,7 +201,7 @@ def stabilize_video(
         "field_order": job.info.field_order or None,  # the input's: tff, bff, progressive
         "deinterlaced": job.info.deinterlace,
         "encoder": {"codec": job.encoding.codec, "pix_fmt": job.encoding.pix_fmt},
-        "focal_px": float(K[0, 0]),
+        "focal_px": float(focal.px if job.lens is None else job.lens.K[0, 0]),
         "focal": focal.summary(),
         "zoom": float(planned.zoom.max()),
         "path": planned.planner,  # smoothed, optimal, bent or uncropped (CameraPath)
@@ -484,17 +484,24 @@ def _motion(
     )
     if focal.note:
         tell(f"focal length: {focal.note}")
-    return track, focal, _rotations(settings, job, track, focal.px, tell)
+    return track, focal, _rotations(settings, job, track, focal, tell)
 
 
 def _rotations(
-    settings: Settings, job: Job, track: VisualTrack, focal: float, tell: Callable[[str], None]
+    settings: Settings,
+    job: Job,
+    track: VisualTrack,
+    choice: FocalChoice,
+    tell: Callable[[str], None],
 ) -> Turns:
     """The clip's turns: from the gyro log when there is one, else the visual track with
     unreliable frames repaired (and no residual motion on them) and its cuts found; under
     a rolling shutter, the rotations between the frames' middle rows, and the row turns
     eased where they would stretch a frame past the budget
-    (:func:`stabilize.warp.rolling.within_stretch`)."""
+    (:func:`stabilize.warp.rolling.within_stretch`). Each shot is taken at its own focal
+    length where it has one (:attr:`FocalChoice.shots`)."""
+    focal = choice.px
+    segments = _focal_segments(choice, len(track.times))
     reliable = np.ones(len(track.rotations), bool)
     cuts = np.zeros(len(track.rotations), bool)
     shutter = None
@@ -504,7 +511,8 @@ def _rotations(
     else:
         breaks = _breaks(track, tell)
         cuts = breaks.cuts
-        R, reliable = repair_track(track, focal, breaks.unrelated)
+        per_pair = choice.per_frame(len(track.times))[:-1]
+        R, reliable = repair_track(track, per_pair, breaks.unrelated)
         rolling, summary = None, None
         from stabilize.shutter import readout_for, visual_rolling_shutter
 
@@ -517,10 +525,21 @@ def _rotations(
             )
     eased = 0
     if rolling is not None:
-        K = _camera_matrix(focal, job.info, job.lens)
         ramp = round(RAMP_S / frame_interval(track.times))
         limit = settings.max_stretch
-        rolling, eased = within_stretch(rolling, K, ramp, 1 - limit / 100)
+        eased_parts = [
+            within_stretch(
+                rolling.frames(first, stop),
+                _camera_matrix(px, job.info, job.lens),
+                ramp,
+                1 - limit / 100,
+            )
+            for first, stop, px in segments
+        ]
+        rolling = RollingShutter(
+            np.concatenate([part.turns for part, _ in eased_parts]), rolling.rows
+        )
+        eased = sum(count for _, count in eased_parts)
         if eased:
             tell(
                 f"rolling shutter: the correction eased on {eased} of {len(track.times)} "
@@ -530,7 +549,17 @@ def _rotations(
     if residual is not None and shutter is not None and rolling is not None:
         from stabilize.shutter.residual import rectified_residual
 
-        residual = rectified_residual(track.samples, R, rolling, focal, job.info.height)
+        parts = [  # each shot's pairs, and the cut after it (whose residual is none)
+            rectified_residual(
+                track.samples.pairs(first, pairs),
+                R[first:pairs],
+                rolling.frames(first, pairs + 1),
+                px,
+                job.info.height,
+            )
+            for first, pairs, px in _pair_segments(segments, len(R))
+        ]
+        residual = np.concatenate(parts)
     elif residual is not None and from_gyro is not None:  # measured after the visual ones
         residual = reexpress(residual, track.rotations, R, focal, job.info.size)
     if residual is not None:
@@ -718,6 +747,31 @@ def _check_output(src: Path, dst: Path, overwrite: bool) -> None:
                 f"{' and others' if len(clash) > 1 else ''}); choose another name or folder"
             )
     check_absent(dst, overwrite)
+
+
+def _focal_segments(choice: FocalChoice, frames: int) -> list[tuple[int, int, float]]:
+    """(first frame, stop, focal length px) of each run of frames at one focal length:
+    the whole clip at the clip's, unless shots have their own (:attr:`FocalChoice.shots`)."""
+    px = choice.per_frame(frames)
+    starts = [0, *(np.flatnonzero(np.diff(px)) + 1).tolist()]
+    stops = [*starts[1:], frames]
+    return [(a, b, float(px[a])) for a, b in zip(starts, stops, strict=True)]
+
+
+def _pair_segments(
+    segments: list[tuple[int, int, float]], pairs: int
+) -> list[tuple[int, int, float]]:
+    """The frame ``segments`` as runs of pairs (first, stop, px): each takes the pair
+    from its last frame into the next segment's first."""
+    return [(first, min(stop, pairs), px) for first, stop, px in segments if first < pairs]
+
+
+def _camera_matrices(choice: FocalChoice, info: VideoInfo, lens: Lens | None, frames: int):
+    """K of the clip (3, 3), or of each of its ``frames`` frames (N, 3, 3) where shots
+    have focal lengths of their own."""
+    if not choice.shots or lens is not None:
+        return _camera_matrix(choice.px, info, lens)
+    return np.stack([_camera_matrix(px, info, None) for px in choice.per_frame(frames)])
 
 
 def _camera_matrix(focal: float, info: VideoInfo, lens: Lens | None) -> NDArray:

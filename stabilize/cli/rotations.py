@@ -62,6 +62,7 @@ def rotations(
     camera's axes as its sensor stores the frames (a clip shown turned, as a phone held
     upright records, is read unturned)."""
     from rotation import so3
+    from rotation.camera import fov_from_focal
     from stabilize.cli.bars import with_bars
     from stabilize.motion.cuts import said_cuts, track_breaks
     from stabilize.motion.estimate import Damaged
@@ -95,7 +96,9 @@ def rotations(
     # 0.015° a pair further from the truth (tests/stabilize/warp/test_lens.py)
     camera = run_or_fail(lambda: read_lens_profile(lens, info.size)) if lens else None
 
-    keep = gcsv is not None  # its flow vectors check each jump the repair would mend
+    # the flow vectors: the .gcsv's repair checks each jump against them, and an edited
+    # clip's shots are voted again at their own focal lengths from them
+    keep = gcsv is not None or not settings.fov_given
 
     def estimate(bar):
         try:
@@ -119,6 +122,9 @@ def rotations(
     track, focal = run_or_fail(lambda: with_bars(estimate, quiet=quiet))
     across = f"{focal.fov_deg:.1f}° across the long side"
     notice(f"focal length {focal.px:.1f} px ({across}, {focal.source})")
+    for first, _, px in focal.shots:  # a montage's shots of another camera
+        at = f"{fov_from_focal(px, focal.span):.1f}° across"
+        notice(f"focal length {px:.1f} px ({at}) from {track.times[first]:.2f} s, that shot's own")
     breaks = track_breaks(track)
     cuts = breaks.cuts
     if cuts.any():  # their rows are no camera's turn

@@ -146,6 +146,26 @@ def interrupted(back: NDArray) -> NDArray[np.bool_]:
     return np.cumsum(spans)[:-1] > 0
 
 
+def shots(cuts: NDArray) -> list[tuple[int, int]]:
+    """The shots, (first frame, stop) each, of a clip whose pairs (frames t, t + 1) that
+    ``cuts`` marks are changes of shot. A shot of one frame (a flash between two cuts)
+    goes with the shot after it (the last, with the one before): a path needs a pair.
+
+    >>> shots(np.array([False, False, True, False]))  # frames 0-2 | 3-4
+    [(0, 3), (3, 5)]
+    >>> shots(np.array([False, True, True, False]))  # frame 2 alone joins 3-4
+    [(0, 2), (2, 5)]
+    """
+    starts = [0]
+    for pair in np.flatnonzero(np.asarray(cuts, bool)):
+        if pair + 1 - starts[-1] >= 2:
+            starts.append(int(pair) + 1)
+    stop = len(cuts) + 1
+    if len(starts) > 1 and stop - starts[-1] < 2:
+        starts.pop()
+    return list(zip(starts, [*starts[1:], stop], strict=True))
+
+
 SAID = 10  # the cuts a notice names by their times
 
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -36,6 +37,7 @@ import flow
 from rotation import HoughEstimator, so3
 from rotation.camera import focal_from_fov, fov_from_focal
 from rotation.focal import FocalEstimate, estimate_focal
+from stabilize.motion.cuts import shots, track_breaks
 from stabilize.motion.estimate import Settle, estimate_again, estimate_rotations, with_bands
 from stabilize.motion.track import VisualTrack
 from stabilize.progress import Progress, no_progress
@@ -49,6 +51,10 @@ FOV_BOUNDS = (15.0, 150.0)  # the fields of view searched, degrees across the lo
 MAX_PAIRS = 120  # consecutive pairs the estimate is made on (the most-turning stretch)
 MIN_TURN_DEG = 0.05  # median pitch/yaw per pair below which f is not pinned down
 DISAGREES = 0.15  # an estimate this far from the metadata's is reported
+# An edited clip's shot whose own estimate lies this far from the clip's is voted and
+# warped at its own (:func:`_by_shot`), where it has at least MIN_SHOT_PAIRS pairs
+SHOT_APART = 0.15
+MIN_SHOT_PAIRS = 30
 
 _METADATA = re.compile(
     r"(?:focal_length\.35mm_equivalent|FocalLengthIn35mmFilm|focal_length_35mm)\s*:\s*([\d.]+)"
@@ -66,10 +72,21 @@ class FocalChoice:
     estimated_px: float | None = None
     metadata_px: float | None = None
     note: str = ""
+    # an edited clip's shots whose own motion pins another focal length down (a montage
+    # of two cameras): (first frame, stop, px) each; the other frames have ``px``
+    shots: tuple[tuple[int, int, float], ...] = ()
 
     @property
     def fov_deg(self) -> float:
         return fov_from_focal(self.px, self.span)
+
+    def per_frame(self, frames: int) -> NDArray[np.float64]:
+        """The focal length (px) of each of ``frames`` frames: its shot's own, else the
+        clip's."""
+        px = np.full(frames, self.px)
+        for first, stop, own in self.shots:
+            px[first:stop] = own
+        return px
 
     def summary(self) -> dict:
         return {
@@ -79,6 +96,10 @@ class FocalChoice:
             "estimated_px": self.estimated_px,
             "metadata_px": self.metadata_px,
             "note": self.note,
+            "shots": [
+                {"first_frame": first, "px": own, "fov_deg": fov_from_focal(own, self.span)}
+                for first, _, own in self.shots
+            ],
         }
 
 
@@ -150,10 +171,13 @@ def estimate_motion(
     long_side = choice.span * ws.scale[0]  # as the default's 69°, however it is held
     settled: list[FocalChoice] = []
 
+    def voting_at(focal: float) -> HoughEstimator:  # px at the flow's size
+        return HoughEstimator(ws.size, focal, max_deg=settings.max_deg)
+
     def estimator(resolved: FocalChoice) -> HoughEstimator:
         if resolved.source != "estimated":
             return start
-        return HoughEstimator(ws.size, resolved.px * ws.scale[0], max_deg=settings.max_deg)
+        return voting_at(resolved.px * ws.scale[0])
 
     def settle(so_far: VisualTrack) -> HoughEstimator | None:
         found = focal_from_track(so_far, start, long_side).focal
@@ -173,8 +197,10 @@ def estimate_motion(
         keep_samples=keep_samples,
         settle=Settle(MAX_PAIRS, settle) if auto else None,
     )
-    if not auto or settled:  # the samples dropped unless asked for
-        return track, settled[0] if settled else choice
+    if not auto:
+        return track, choice
+    if settled:  # its samples dropped after the settling, unless asked for
+        return _by_shot(track, settled[0], estimator(settled[0]), voting_at, long_side, bands)
     kept = (lambda t: t) if keep_samples else (lambda t: replace(t, samples=None))
     curve = focal_from_track(track, start, long_side)
     if curve.focal is not None:
@@ -185,8 +211,51 @@ def estimate_motion(
         note = f"the clip's motion does not pin the focal length down: {choice.source} kept"
         resolved = replace(choice, note=note)
     if resolved.source != "estimated":
-        return kept(with_bands(start, track, bands)), resolved
-    return kept(estimate_again(estimator(resolved), track, bands)), resolved
+        track = with_bands(start, track, bands)
+    else:
+        track = estimate_again(estimator(resolved), track, bands)
+    voted = estimator(resolved)
+    track, resolved = _by_shot(track, resolved, voted, voting_at, long_side, bands)
+    return kept(track), resolved
+
+
+def _by_shot(
+    track: VisualTrack,
+    resolved: FocalChoice,
+    voted: HoughEstimator,
+    voting_at: Callable[[float], HoughEstimator],
+    long_side: float,
+    bands: int,
+) -> tuple[VisualTrack, FocalChoice]:
+    """An edited clip's shots each at its own focal length, where its motion pins one
+    down ``SHOT_APART`` or more from the clip's (a montage of two cameras), its pairs
+    voted again at it (by ``voting_at`` that focal length, px at the flow's size); the
+    track was ``voted`` at the clip's. A shot of fewer than ``MIN_SHOT_PAIRS`` pairs
+    keeps the clip's."""
+    cuts = track_breaks(track).cuts
+    if track.samples is None or not cuts.any():
+        return track, resolved
+    scale = voted.focal / resolved.px  # flow px per input px
+    own: list[tuple[int, int, float]] = []
+    for first, stop in shots(cuts):
+        if stop - first - 1 < MIN_SHOT_PAIRS:
+            continue
+        part = track.pairs(first, stop - 1)
+        found = focal_from_track(part, voted, long_side).focal
+        if found is None or abs(found / voted.focal - 1) < SHOT_APART:
+            continue
+        track = track.spliced(first, estimate_again(voting_at(found), part, bands))
+        own.append((first, stop, found / scale))
+    if not own:
+        return track, resolved
+    times = track.times
+    said = ", ".join(
+        f"{fov_from_focal(px, resolved.span):.1f}° from {times[first]:.2f} s"
+        for first, _, px in own
+    )
+    note = f"{resolved.note}; " if resolved.note else ""
+    note += f"shots of another camera, at their own: {said}"
+    return track, replace(resolved, shots=tuple(own), note=note)
 
 
 def _ruled_out(start: FocalChoice, px: float) -> FocalChoice:

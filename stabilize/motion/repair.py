@@ -35,7 +35,6 @@ against (-8.5, 8.8), (-4.5, 1.3) and (-2.5, 2.1). The clip's residual shake went
 from __future__ import annotations
 
 from collections.abc import Callable
-from functools import partial
 
 import numpy as np
 from numpy.typing import NDArray
@@ -117,14 +116,21 @@ def repair_unreliable(
 
 
 def repair_track(
-    track: VisualTrack, focal: float, unrelated: NDArray | None = None
+    track: VisualTrack, focal: float | NDArray, unrelated: NDArray | None = None
 ) -> tuple[NDArray, NDArray]:
     """:func:`repair_unreliable` on a pass-1 track, its own flow vectors (where it kept
-    them) checking each jump at the focal length ``focal`` (px, full size): the turns
-    the stabiliser follows, before any rolling shutter's rows are dated."""
+    them) checking each jump at the focal length ``focal`` (px, full size; or each
+    pair's, (N-1,)): the turns the stabiliser follows, before any rolling shutter's rows
+    are dated."""
     samples = track.samples
     if samples is None:
         return repair_unreliable(track.rotations, track.support, unrelated=unrelated)
-    agreeing = partial(samples.agreeing, focal=focal)
-    refined = partial(samples.refined, focal=focal)
+    each = np.broadcast_to(np.asarray(focal, np.float64), (len(track.rotations),))
+
+    def agreeing(k: int, R: NDArray) -> int:
+        return samples.agreeing(k, R, float(each[k]))
+
+    def refined(k: int, R: NDArray) -> NDArray:
+        return samples.refined(k, R, float(each[k]))
+
     return repair_unreliable(track.rotations, track.support, agreeing, refined, unrelated)

@@ -126,6 +126,31 @@ class VisualTrack:
             None if self.resumes is None else self.resumes[first:stop],
         )
 
+    def spliced(self, first: int, part: VisualTrack) -> VisualTrack:
+        """The track with its pairs from ``first`` on measured again as ``part`` says
+        (its rotations, support, rows, bands and residual; a shot voted at its own focal
+        length): the flow vectors and what the pictures said are the same."""
+
+        def put(mine: NDArray | None, theirs: NDArray | None, axis: int = 0) -> NDArray | None:
+            if mine is None or theirs is None:
+                return mine
+            out = mine.copy()
+            index = [slice(None)] * out.ndim
+            index[axis] = slice(first, first + theirs.shape[axis])
+            out[tuple(index)] = theirs
+            return out
+
+        return replace(
+            self,
+            rotations=put(self.rotations, part.rotations),
+            support=put(self.support, part.support),
+            rows=put(self.rows, part.rows),
+            bands=put(self.bands, part.bands, 1),
+            band_rows=put(self.band_rows, part.band_rows, 1),
+            band_support=put(self.band_support, part.band_support, 1),
+            residual=put(self.residual, part.residual),
+        )
+
 
 def mean_rows(inliers: NDArray[np.bool_], sample_rows: NDArray, height: int) -> NDArray:
     """Mean height (0 top .. 1 bottom) of the flow vectors that agreed with each of a

@@ -25,6 +25,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
+from stabilize.motion.cuts import shots
 from stabilize.path import residual as planar
 from stabilize.path.budget import Trajectory, respect_zoom_budget
 from stabilize.path.optimal import optimal_path
@@ -59,8 +60,10 @@ def plan_path(
 ) -> CameraPath:
     """The planned path of frames at ``times`` with rotations R_t (N-1, 3, 3), and the
     similarities (N-1, 4) they leave (``residual``; compensated as ``settings.motion``
-    says). Pairs that ``cuts`` (N-1,) marks are changes of shot: each shot is planned
-    on its own (:func:`shots`), and R_t across a cut only links the raw orientations.
+    says), seen through K (3, 3), or each frame's (N, 3, 3; one for each shot). Pairs
+    that ``cuts`` (N-1,) marks are changes of shot: each shot is planned on its own
+    (:func:`stabilize.motion.cuts.shots`), and R_t across a cut only links the raw
+    orientations.
     ``progress`` hears of the frames planned (a 10-minute clip's path takes about 13 s
     on this 2-core machine)."""
     if settings.crop not in CROP_MODES:
@@ -72,7 +75,7 @@ def plan_path(
                 times[first:stop],
                 rotations[first : stop - 1],
                 support[first : stop - 1],
-                K,
+                K[first] if K.ndim == 3 else K,
                 size,
                 settings,
                 None if rolling is None else rolling.frames(first, stop),
@@ -84,6 +87,7 @@ def plan_path(
         ]
         joined = _joined(planned, times, rotations, support)
         return replace(joined, shots=tuple(first for first, _ in spans))
+    K = K[0] if K.ndim == 3 else K  # one shot, one camera
     measured = residual is not None and settings.motion != "rotation"
     if not measured:
         residual = np.zeros((len(rotations), 4))
@@ -189,26 +193,6 @@ def plan_path(
     return CameraPath(times, rotations, support, O, S, zoom, H, K, by_row, rows, lens, D, planner)
 
 
-def shots(cuts: NDArray) -> list[tuple[int, int]]:
-    """The shots, (first frame, stop) each, of a clip whose pairs (frames t, t + 1) that
-    ``cuts`` marks are changes of shot. A shot of one frame (a flash between two cuts)
-    goes with the shot after it (the last, with the one before): a path needs a pair.
-
-    >>> shots(np.array([False, False, True, False]))  # frames 0-2 | 3-4
-    [(0, 3), (3, 5)]
-    >>> shots(np.array([False, True, True, False]))  # frame 2 alone joins 3-4
-    [(0, 2), (2, 5)]
-    """
-    starts = [0]
-    for pair in np.flatnonzero(np.asarray(cuts, bool)):
-        if pair + 1 - starts[-1] >= 2:
-            starts.append(int(pair) + 1)
-    stop = len(cuts) + 1
-    if len(starts) > 1 and stop - starts[-1] < 2:
-        starts.pop()
-    return list(zip(starts, [*starts[1:], stop], strict=True))
-
-
 def _joined(
     planned: list[CameraPath], times: NDArray, rotations: NDArray, support: NDArray
 ) -> CameraPath:
@@ -223,6 +207,9 @@ def _joined(
     O = orientations_from_rotations(rotations)
     turns = joined("smooth") @ np.swapaxes(joined("raw"), -1, -2)
     first = planned[0]
+    K = first.K
+    if any(not np.array_equal(shot.K, K) for shot in planned):  # shots of two cameras
+        K = np.concatenate([np.repeat(shot.K[None], len(shot.times), 0) for shot in planned])
     return CameraPath(
         times,
         rotations,
@@ -231,7 +218,7 @@ def _joined(
         turns @ O,
         joined("zoom"),
         joined("homographies"),
-        first.K,
+        K,
         None if first.row_corrections is None else joined("row_corrections"),
         first.knot_rows,
         first.lens,

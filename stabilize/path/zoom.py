@@ -1,7 +1,7 @@
 """Choosing each frame's zoom from the zoom it needs (the crop modes).
 
 * ``auto``: one zoom for the clip, just enough to hide every border (an edited clip's
-  shots are planned each on its own, :func:`stabilize.path.plan.shots`: one for each);
+  shots are planned each on its own, :func:`stabilize.motion.cuts.shots`: one for each);
 * ``dynamic``: a smoothly varying zoom, never below any frame's need;
 * ``none``: no zoom (borders may show).
 """

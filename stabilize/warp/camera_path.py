@@ -35,7 +35,7 @@ class CameraPath:
     smooth: NDArray  # (N, 3, 3) S_t
     zoom: NDArray  # (N,) applied zoom
     homographies: NDArray  # (N, 3, 3) input → output pixels (the middle row's)
-    K: NDArray
+    K: NDArray  # (3, 3), or each frame's (N, 3, 3): an edited clip's shots of two cameras
     # Rolling shutter: the corrections of each knot row (N, B, 3, 3) at input rows (B,).
     row_corrections: NDArray | None = None
     knot_rows: NDArray | None = None
@@ -48,7 +48,7 @@ class CameraPath:
     # that programme found no answer), "bent" (over the budget where it found none, so
     # bent towards the raw one) or "uncropped"
     planner: str = "smoothed"
-    # The first frame of each shot, each planned on its own (stabilize.path.plan.shots):
+    # The first frame of each shot, each planned on its own (stabilize.motion.cuts.shots):
     # an edited clip's cuts
     shots: tuple[int, ...] = (0,)
 
@@ -117,7 +117,8 @@ class CameraPath:
         C = self.row_corrections[k] if rolling else self.corrections(k)
         if self.lens is not None:
             return lens_source(self.lens, C, self.zoom[k], self.knot_rows)
-        return rolling_source(homography(self.K, C, self.zoom[k]), self.knot_rows)
+        K = self.K[k] if self.K.ndim == 3 else self.K
+        return rolling_source(homography(K, C, self.zoom[k]), self.knot_rows)
 
     def warp(
         self, k: int, frame: NDArray[np.uint8], full_range: bool = False, border: str = "black"
