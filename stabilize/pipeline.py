@@ -482,8 +482,11 @@ def _motion(
         lens=job.lens,
         keep_samples=keep,
     )
-    if focal.note:
-        tell(f"focal length: {focal.note}")
+    if job.log is not None:  # a gyro log is one camera's: its clip is warped through one K
+        focal = replace(focal, shots=())
+    for said in (focal.note, focal.said_shots(track.times)):
+        if said:
+            tell(f"focal length: {said}")
     return track, focal, _rotations(settings, job, track, focal, tell)
 
 

@@ -62,7 +62,6 @@ def rotations(
     camera's axes as its sensor stores the frames (a clip shown turned, as a phone held
     upright records, is read unturned)."""
     from rotation import so3
-    from rotation.camera import fov_from_focal
     from stabilize.cli.bars import with_bars
     from stabilize.motion.cuts import said_cuts, track_breaks
     from stabilize.motion.estimate import Damaged
@@ -122,9 +121,8 @@ def rotations(
     track, focal = run_or_fail(lambda: with_bars(estimate, quiet=quiet))
     across = f"{focal.fov_deg:.1f}° across the long side"
     notice(f"focal length {focal.px:.1f} px ({across}, {focal.source})")
-    for first, _, px in focal.shots:  # a montage's shots of another camera
-        at = f"{fov_from_focal(px, focal.span):.1f}° across"
-        notice(f"focal length {px:.1f} px ({at}) from {track.times[first]:.2f} s, that shot's own")
+    if focal.shots:  # a montage of two cameras
+        notice(f"focal length: {focal.said_shots(track.times)}")
     breaks = track_breaks(track)
     cuts = breaks.cuts
     if cuts.any():  # their rows are no camera's turn

@@ -181,7 +181,7 @@ def test_a_montage_of_two_cameras_is_voted_shot_by_shot(tmp_path, monkeypatch):
     assert [first for first, _, _ in focal.shots][-1] == 60
     assert fov_from_focal(px[0], 320) == pytest.approx(40, rel=0.1)
     assert fov_from_focal(px[60], 320) == pytest.approx(100, rel=0.05)
-    assert "shots of another camera, at their own" in focal.note
+    assert focal.said_shots(track.times).endswith("from 2.00 s")
 
     def off_deg(track) -> float:
         seen = so3.log_so3(track.rotations[60:119])
@@ -205,3 +205,4 @@ def test_a_montage_of_two_cameras_is_warped_shot_by_shot(tmp_path):
     assert path.K.shape == (120, 3, 3) and path.K[60, 0, 0] == pytest.approx(wide["px"])
     assert path.K[59, 0, 0] > 2 * wide["px"]  # the 40° shot's
     assert summary["frames"] == 120 and path.row_corrections is not None
+    assert any("shots of another camera, each at its own" in n for n in summary["notices"])
