@@ -19,8 +19,8 @@ RANK = {
     "evaluate": 7,
     "shutter": 6,
     "gyro": 5,
+    "path": 5,  # the plan follows the motion: its shots are those of motion.cuts
     "motion": 4,
-    "path": 4,
     "warp": 3,
     "synth": 2,
     "settings": 2,
