@@ -96,8 +96,9 @@ def rotations(
     camera = run_or_fail(lambda: read_lens_profile(lens, info.size)) if lens else None
 
     # the flow vectors: the .gcsv's repair checks each jump against them, and an edited
-    # clip's shots are voted again at their own focal lengths from them
-    keep = gcsv is not None or not settings.fov_given
+    # clip's shots are voted again at their own focal lengths from them (where the focal
+    # length is estimated: neither given nor a lens's)
+    keep = gcsv is not None or (camera is None and not settings.fov_given)
 
     def estimate(bar):
         try:

@@ -232,11 +232,11 @@ def estimate_motion(
     else:
         note = f"the clip's motion does not pin the focal length down: {choice.source} kept"
         resolved = replace(choice, note=note)
+    voted = estimator(resolved)  # start's, unless estimated
     if resolved.source != "estimated":
-        track = with_bands(start, track, bands)
+        track = with_bands(voted, track, bands)
     else:
-        track = estimate_again(estimator(resolved), track, bands)
-    voted = estimator(resolved)
+        track = estimate_again(voted, track, bands)
     track, resolved = _by_shot(track, resolved, voted, voting_at, long_side, bands)
     return kept(track), resolved
 
