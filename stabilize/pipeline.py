@@ -562,7 +562,8 @@ def _rotations(
             )
             for first, pairs, px in _pair_segments(segments, len(R))
         ]
-        residual = np.concatenate(parts)
+        # held to the strides of a high frame rate again (stabilize.motion.strides)
+        residual = np.concatenate(parts) + (0.0 if track.held is None else track.held)
     elif residual is not None and from_gyro is not None:  # measured after the visual ones
         residual = reexpress(residual, track.rotations, R, focal, job.info.size)
     if residual is not None:

@@ -7,7 +7,8 @@ rotation is also estimated from horizontal bands of the frame alone, which dates
 rows of a rolling-shutter frame (:attr:`VisualTrack.bands`). The similarity each
 rotation leaves in the frame (the parallax of a walk) is measured on the background's
 vectors, those that land within a few pixels of where the rotation puts them
-(:mod:`stabilize.motion.residual`).
+(:mod:`stabilize.motion.residual`). At a high frame rate the flow between frames a
+thirtieth of a second apart is sampled too, and kept (:mod:`stabilize.motion.strides`).
 
 Only the vectors measured where the first frame has texture in two directions
 (:mod:`flow.texture`) vote for the frame's rotation and measure what it leaves: on a
@@ -64,6 +65,7 @@ def estimate_rotations(
     lens: Lens | None = None,
     keep_samples: bool = False,
     settle: Settle | None = None,
+    every: int = 1,
 ) -> VisualTrack:
     """Pass 1: the clip's rotations, frames streamed at the working size; with
     ``keep_samples``, the track keeps the flow vectors they came from (``samples``).
@@ -73,7 +75,9 @@ def estimate_rotations(
     Frame times are the container's timestamps unless given (e.g. from a sensor log).
     ``bands`` > 0 also estimates each pair's rotation from that many horizontal bands of
     the frame alone (for the rolling-shutter readout; about 0.5 ms per band and pair).
-    With a fisheye ``lens`` the frames are first remapped to a pinhole view.
+    With a fisheye ``lens`` the frames are first remapped to a pinhole view. With
+    ``every`` ≥ 2, the flow vectors between frames that many apart are kept too
+    (:attr:`VisualTrack.strides`; :mod:`stabilize.motion.strides`).
     """
     times = frame_times(path, info.input_args) if times is None else np.asarray(times)
     if len(times) < 2:
@@ -92,6 +96,9 @@ def estimate_rotations(
     resumed: list[int] = []  # ... and, where unlike, how far back its picture resumes
     pictures = _noting_likeness(frames, likenesses, resumed)
     noted = _noting_texture(pictures, estimator.grid, textures)
+    strides: list[tuple] = []  # each stride's (u, v, valid, measured), while it streams
+    if every >= 2:
+        noted = _noting_strides(noted, every, backend, estimator, strides)
     # A chunk's vote runs while the next chunk's flow is computed: without the overlap,
     # pass 1 used 1.65 of this machine's 2 cores (1080p, 10 s, with the bands' votes
     # below: 7.8 s, 7.0 with it), when the flow kept one core busy; it now takes pairs
@@ -125,12 +132,15 @@ def estimate_rotations(
         times = times[:n] if len(times) > n else np.arange(n) / max(info.fps, 1.0)
     samples = _samples(kept, estimator, ws) if kept else None
     track = _track(times, found, voted)
+    spanned = (n - 1) // every if every >= 2 else 0  # a frame lost at the end: one less
     return replace(
         track,
         samples=samples,
         residual=np.concatenate(residual),
         likeness=np.array(likenesses[: n - 1]),
         resumes=np.array(resumed[: n - 1], np.int64),
+        strides=_samples(strides[:spanned], estimator, ws) if spanned else None,
+        every=every if spanned else 1,
     )
 
 
@@ -195,6 +205,8 @@ def estimate_again(estimator: HoughEstimator, track: VisualTrack, bands: int = 0
         residual=np.concatenate(residual),
         likeness=track.likeness,
         resumes=track.resumes,
+        strides=track.strides,
+        every=track.every,
     )
 
 
@@ -289,11 +301,18 @@ def _estimator_and_frames(
     if lens is None:
         focal = settings.focal_px(info.size) * ws.scale[0]
         return HoughEstimator(ws.size, focal, max_deg=settings.max_deg), frames
+    estimator = lens_estimator(lens, ws, settings.max_deg)
     K_ws = scale_intrinsics(lens.K, *ws.scale)
-    focal, center = float(K_ws[0, 0]), (float(K_ws[0, 2]), float(K_ws[1, 2]))
-    estimator = HoughEstimator(ws.size, focal, center=center, max_deg=settings.max_deg)
-    maps = pinhole_map(replace(lens, K=K_ws), ws.size, focal, center)
+    maps = pinhole_map(replace(lens, K=K_ws), ws.size, estimator.focal, estimator.center)
     return estimator, (cv2.remap(f, *maps, cv2.INTER_LINEAR) for f in frames)
+
+
+def lens_estimator(lens: Lens, ws: WorkingSize, max_deg: float) -> HoughEstimator:
+    """The estimator of a fisheye ``lens``'s pinhole view at the working size: its focal
+    length and principal point."""
+    K_ws = scale_intrinsics(lens.K, *ws.scale)
+    center = (float(K_ws[0, 2]), float(K_ws[1, 2]))
+    return HoughEstimator(ws.size, float(K_ws[0, 0]), center=center, max_deg=max_deg)
 
 
 def _noting_texture(
@@ -303,6 +322,29 @@ def _noting_texture(
     measure flow at the sample grid (:func:`flow.texture.textured`)."""
     for frame in frames:
         textures.append(textured(frame, grid.rows, grid.cols))
+        yield frame
+
+
+def _noting_strides(
+    frames: Iterator[NDArray],
+    every: int,
+    backend: flow.FlowBackend,
+    estimator: HoughEstimator,
+    strides: list[tuple],
+) -> Iterator[NDArray]:
+    """The frames as they are, the flow from each ``every``-th frame to the next such
+    sampled into ``strides`` as it streams: (u, v, valid, measured) of one pair each,
+    measured where the earlier frame has texture (one field more per ``every`` pairs;
+    only the last such frame is held)."""
+    grid = estimator.grid
+    key: NDArray | None = None
+    for index, frame in enumerate(frames):
+        if index % every == 0:
+            if key is not None:
+                u, v, valid = estimator.samples(backend(key, frame)[None])
+                measured = valid & textured(key, grid.rows, grid.cols)
+                strides.append((u.astype(np.float32), v.astype(np.float32), valid, measured))
+            key = frame
         yield frame
 
 

@@ -101,6 +101,13 @@ class VisualTrack:
     # (N-1,) of a pair whose frames look unlike, how far back its later frame finds a
     # picture it looks alike to: the shot resumed after an interruption (:mod:`.cuts`)
     resumes: NDArray[np.int64] | None = None
+    # at a high frame rate, the flow vectors between frames ``every`` apart (frames 0,
+    # K, 2K, ...): a stride's pair each (:mod:`.strides`); None, and 1, below 45 fps
+    strides: Samples | None = None
+    every: int = 1
+    # (N-1, 4) what holding the pairs to their strides added to each one's residual, to
+    # add again where the residual is measured anew (under a rolling shutter)
+    held: NDArray[np.float64] | None = None
 
     @classmethod
     def from_rotations(cls, times: NDArray, rotations: NDArray) -> VisualTrack:

@@ -45,6 +45,7 @@ leaves shake that the crop could hold (:func:`stabilize.path.plan.plan_path`).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from functools import partial
 
@@ -63,6 +64,7 @@ from stabilize.path.budget import Trajectory
 # vid.stab 0.61, 0.99, 6.86, 3.05). Adding the high-passed velocity to the L1 programme
 # as a fifth term helped the GoPro clips and made the 45° walk worse (3.12–3.24).
 HOLD = 1e-4
+HOLD_FPS = 30.0  # the frame rate HOLD was measured at (:func:`hold_at`)
 ROUNDS = 6  # linearise, solve, check
 STEP = 1e-4  # finite-difference step of the Jacobian (rad, normalised units)
 MARGIN_PX = 0.25  # constraints are kept this far inside the frame (the linearisation)
@@ -71,6 +73,9 @@ MARGIN_PX = 0.25  # constraints are kept this far inside the frame (the linearis
 # bind throughout planned in 6.4 s with windows of 600, 2.5 s with windows of 150.
 WINDOW = 150
 OVERLAP = 40
+# ... in σ of the smoothing where that is more (a high frame rate, a long --smooth)
+WINDOW_SIGMAS = 2.5
+OVERLAP_SIGMAS = 1.0
 FIXED = 3  # frames at a window's start held to the previous window's answer
 # A programme starts with the rows this close to binding at its linearisation point (px
 # of the crop; the ceilings' own units), and takes in any its answer breaks by more than
@@ -131,6 +136,7 @@ def optimal_path(
     middle: Middle | None = None,
     floor: float = 0.0,
     settled: Callable[[int], None] = lambda frames: None,
+    hold: float = HOLD,
 ) -> Trajectory | None:
     """The steadiest path in the sense above whose every frame covers the output; None
     where the programme fails (the caller falls back). ``corners``: the indices, among
@@ -138,7 +144,7 @@ def optimal_path(
     upper bounds on δ (+inf for none); ``sigma``: the low-pass's σ, in frames;
     ``middle``, ``floor``: each frame's σ_min/σ_max at the output's middle is held at
     least ``floor`` (none for 0 or without ``middle``); ``settled`` hears how many
-    frames are planned so far, after each window."""
+    frames are planned so far, after each window; ``hold``: η (:func:`hold_at`)."""
     n = len(target.turn)
     k = 3 + len(parts)
     delta = np.zeros((n, k))
@@ -146,14 +152,15 @@ def optimal_path(
     # without the stretch bound where no path keeps to it and to the crop
     bounds = [(middle, floor)] if middle is not None and floor > 0 else []
     bounds.append((None, 0.0))
+    window_frames, overlap = windows(sigma)
     start = 0
     while start < n:
-        stop = min(n, start + WINDOW)
+        stop = min(n, start + window_frames)
         fixed = FIXED if start > 0 else 0
         frames = np.arange(start, stop)
         window = (target, sources, size, parts, corners, frames, delta, fixed)
         for bound in bounds:
-            found = _solve_window(*window, ceiling[frames], sigma, bound)
+            found = _solve_window(*window, ceiling[frames], sigma, hold, bound)
             if found is not None:
                 break
         if found is None:
@@ -164,15 +171,41 @@ def optimal_path(
             begun = delta.copy()
             begun[frames] = found
             again = (target, sources, size, parts, corners, frames, begun, fixed)
-            kept = _solve_window(*again, ceiling[frames], sigma, bounds[0], from_start=True)
+            kept = _solve_window(*again, ceiling[frames], sigma, hold, bounds[0], from_start=True)
             found = found if kept is None else kept
-        keep = stop if stop == n else stop - OVERLAP + FIXED
+        keep = stop if stop == n else stop - overlap + FIXED
         delta[start + fixed : keep] = found[fixed : keep - start]
         settled(keep)
         if stop == n:
             break
-        start = stop - OVERLAP
+        start = stop - overlap
     return deviate(target, delta, parts)
+
+
+def hold_at(interval: float) -> float:
+    """η for frames ``interval`` s apart: ``HOLD`` up to 30 fps, where it was measured
+    (the bench's clips run at 20–30 fps), and above, ``HOLD``·(30·interval)², which
+    weighs a second of path against its shake as at 30 fps (the shake's velocities
+    shrink with the interval, and their count grows as the hold's). At 240 fps ``HOLD``
+    outweighed the shake 64 times as much as at 30, and the path kept to the smoother's
+    bent start: a steady pan, known exactly, came out 0.41 px a thirtieth of a second
+    shaky (windows of 10σ), 0.28 with η so (0.18 at 30 fps)."""
+    return HOLD * min(1.0, HOLD_FPS * interval) ** 2
+
+
+def windows(sigma: float) -> tuple[int, int]:
+    """(frames per programme, frames each shares with the next) for a low-pass of σ
+    ``sigma`` frames: ``WINDOW`` and ``OVERLAP``, or ``WINDOW_SIGMAS`` and
+    ``OVERLAP_SIGMAS`` σ where those are more. A window must see enough of what the
+    smoothing sees. At 240 fps (σ = 120 frames), given the gyro's exact turns of a
+    rendered steady pan, windows of 150 frames overlapping by 60 left 0.50 px of shake
+    a thirtieth of a second (the same pan at 30 fps: 0.18); 200 by 80, 0.37; 2.5σ by σ
+    (300 by 120), 0.26; 10σ by 8σ/3, 0.28, its programmes 2.5 times as long (6 s of
+    240 fps planned in 10 s at 2.5σ, in 38 s at 10σ, in 4.4 s at 150 by 40)."""
+    return (
+        max(WINDOW, math.ceil(WINDOW_SIGMAS * sigma)),
+        max(OVERLAP, math.ceil(OVERLAP_SIGMAS * sigma)),
+    )
 
 
 def _solve_window(
@@ -186,6 +219,7 @@ def _solve_window(
     fixed: int,
     ceiling: NDArray,
     sigma: float,
+    hold: float,
     stretch: tuple[Middle | None, float],
     from_start: bool = False,
 ) -> NDArray | None:
@@ -203,7 +237,7 @@ def _solve_window(
     active = np.zeros(src.shape[:2], bool)
     active[fixed:, corners] = True  # the held frames were checked in the last window
     margin = np.full(len(frames), MARGIN_PX)
-    cost = _shake_cost(unrolled(part, parts), sigma)  # the same in every round
+    cost = _shake_cost(unrolled(part, parts), sigma, hold)  # the same in every round
     middle, floor = stretch
     bounded = middle is not None and floor > 0
     tight = np.ones(len(frames))  # the stretch bound's share, where the linearisation was off
@@ -393,7 +427,9 @@ def shake_operator(n: int, k: int, sigma: float) -> sparse.csr_array:
     return sparse.kron(sparse.csr_array(high) @ step, sparse.eye_array(k)).tocsr()
 
 
-def _shake_cost(p0: NDArray, sigma: float) -> tuple[sparse.csc_array, NDArray] | None:
+def _shake_cost(
+    p0: NDArray, sigma: float, hold: float = HOLD
+) -> tuple[sparse.csc_array, NDArray] | None:
     """(P, q) of the objective ½ δᵀP δ + qᵀδ = (½ ‖(I - G_σ) Δ(p0 + δ)‖² + ½ η ‖δ‖²) / c₀
     + const for the target's unrolled path p0 (n, k); None for fewer than 3 frames.
 
@@ -409,7 +445,7 @@ def _shake_cost(p0: NDArray, sigma: float) -> tuple[sparse.csc_array, NDArray] |
     H = shake_operator(n, k, sigma)
     shake = H @ p0.ravel()
     unit = max(0.5 * float(shake @ shake), STILL * n * k)
-    P = (H.T @ H + HOLD * sparse.eye_array(n * k)) / unit
+    P = (H.T @ H + hold * sparse.eye_array(n * k)) / unit
     return sparse.triu(P).tocsc(), H.T @ shake / unit
 
 

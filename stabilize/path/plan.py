@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from stabilize.motion.cuts import shots
 from stabilize.path import residual as planar
 from stabilize.path.budget import Trajectory, respect_zoom_budget
-from stabilize.path.optimal import optimal_path
+from stabilize.path.optimal import hold_at, optimal_path
 from stabilize.path.smoothing import orientations_from_rotations, smooth_orientations
 from stabilize.path.zoom import CROP_MODES, choose_zoom
 from stabilize.progress import Progress, no_progress
@@ -143,8 +143,9 @@ def plan_path(
         parts = planar.MOTION_MODELS[settings.motion] if measured else ()
         ceiling, sigma = _ceiling(raw, target, parts), settings.smooth / frame_interval(times)
         floor = 1 - settings.max_stretch / 100
+        hold = hold_at(frame_interval(times))
         return optimal_path(
-            target, sources, size, parts, CORNERS, ceiling, sigma, middle, floor, settled
+            target, sources, size, parts, CORNERS, ceiling, sigma, middle, floor, settled, hold
         )
 
     path = planned(settings.smooth)
