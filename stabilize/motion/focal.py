@@ -223,7 +223,8 @@ def estimate_motion(
         return estimator(settled[0])
 
     def strided(track: VisualTrack, resolved: FocalChoice) -> VisualTrack:
-        return held_to_strides(track, _strides_voted(track, resolved, estimator, voting_at))
+        voted = _strides_voted(track, resolved, estimator, voting_at, bands)
+        return held_to_strides(track, voted)
 
     # at a high frame rate the focal length is searched on the strides, at the end: a
     # pair of a 240 fps clip turns too little to tell its x²/f terms from the flow's
@@ -270,11 +271,13 @@ def _strides_voted(
     resolved: FocalChoice,
     estimator: Callable[[FocalChoice], HoughEstimator],
     voting_at: Callable[[float], HoughEstimator],
+    bands: int = 0,
 ) -> VisualTrack | None:
     """The track's strides (:mod:`stabilize.motion.strides`) voted at the focal length
-    ``resolved``, those within a shot of its own at that shot's; None where it has none."""
+    ``resolved``, those within a shot of its own at that shot's, with ``bands`` bands
+    each; None where it has none."""
     voted = estimator(resolved)
-    strided = strided_track(track, voted)
+    strided = strided_track(track, voted, bands)
     if strided is None:
         return None
     scale = voted.focal / resolved.px  # flow px per input px
@@ -282,7 +285,7 @@ def _strides_voted(
     for first, stop, px in resolved.shots:  # frames first..stop-1
         j0, j1 = -(-first // every), (stop - 1) // every
         if j1 > j0:
-            part = estimate_again(voting_at(px * scale), strided.pairs(j0, j1))
+            part = estimate_again(voting_at(px * scale), strided.pairs(j0, j1), bands)
             strided = strided.spliced(j0, part)
     return strided
 

@@ -54,17 +54,19 @@ def stride_for(fps: float) -> int:
     return max(1, round(fps / STRIDE_FPS)) if fps > 0 else 1
 
 
-def strided_track(track: VisualTrack, estimator: HoughEstimator) -> VisualTrack | None:
+def strided_track(
+    track: VisualTrack, estimator: HoughEstimator, bands: int = 0
+) -> VisualTrack | None:
     """The track of the strides pass 1 measured (:attr:`VisualTrack.strides`), voted by
-    ``estimator``: one pair per stride, frames 0, K, 2K, ..., with their samples; None
-    where there are none."""
+    ``estimator``: one pair per stride, frames 0, K, 2K, ..., with their samples (and
+    ``bands`` bands each); None where there are none."""
     strides, every = track.strides, track.every
     if strides is None or every < 2 or len(strides.u) == 0:
         return None
     count = len(strides.u)
     times = track.times[: count * every + 1 : every]
     blank = VisualTrack.from_rotations(times, np.broadcast_to(np.eye(3), (count, 3, 3)))
-    return estimate_again(estimator, replace(blank, samples=strides))
+    return estimate_again(estimator, replace(blank, samples=strides), bands)
 
 
 def held_to_strides(track: VisualTrack, strided: VisualTrack | None) -> VisualTrack:
@@ -89,7 +91,9 @@ def held_to_strides(track: VisualTrack, strided: VisualTrack | None) -> VisualTr
         if held is not None and strided.residual is not None:
             held[part] = (strided.residual[j] - track.residual[part].sum(axis=0)) / every
     residual = None if held is None else track.residual + held
-    return replace(track, rotations=R, residual=residual, bands=bands, held=held)
+    return replace(
+        track, rotations=R, residual=residual, bands=bands, held=held, stride_track=strided
+    )
 
 
 def usable(track: VisualTrack, strided: VisualTrack) -> NDArray[np.bool_]:

@@ -108,6 +108,9 @@ class VisualTrack:
     # (N-1, 4) what holding the pairs to their strides added to each one's residual, to
     # add again where the residual is measured anew (under a rolling shutter)
     held: NDArray[np.float64] | None = None
+    # the strides voted (a pair each, frames 0, K, 2K, ...; their bands where the pairs
+    # have them): a rolling shutter's readout is searched on them (:mod:`.strides`)
+    stride_track: VisualTrack | None = None
 
     @classmethod
     def from_rotations(cls, times: NDArray, rotations: NDArray) -> VisualTrack:

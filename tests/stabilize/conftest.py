@@ -17,3 +17,11 @@ def render(folder: Path, **options) -> Path:
 @pytest.fixture(scope="session")
 def shaky(tmp_path_factory) -> Path:
     return render(tmp_path_factory.mktemp("shaky"), seed=11, shake_deg=1.5, crowd=4)
+
+
+@pytest.fixture(scope="session")
+def fast_walk(tmp_path_factory) -> Path:
+    """A rendered 240 fps walk, 1.5 s, with its truth (a global shutter)."""
+    return render(
+        tmp_path_factory.mktemp("fast"), seconds=1.5, fps=240.0, seed=3, shake_deg=1.5, crowd=4
+    )

@@ -19,7 +19,6 @@ from stabilize.motion.track import VisualTrack
 from stabilize.pipeline import _motion, prepare
 from stabilize.progress import no_progress
 from stabilize.video import probe
-from tests.stabilize.conftest import render
 
 EVERY = 8
 
@@ -87,14 +86,6 @@ def test_a_stride_that_cannot_speak_for_its_pairs_leaves_them_as_voted():
     held = held_to_strides(track, strided)
     assert np.array_equal(held.rotations[:16], track.rotations[:16])
     assert not np.array_equal(held.rotations[16:], track.rotations[16:])
-
-
-@pytest.fixture(scope="module")
-def fast_walk(tmp_path_factory) -> Path:
-    """A rendered 240 fps walk, 1.5 s, with its truth."""
-    return render(
-        tmp_path_factory.mktemp("fast"), seconds=1.5, fps=240.0, seed=3, shake_deg=1.5, crowd=4
-    )
 
 
 def _truth(clip: Path) -> tuple[NDArray, float]:

@@ -5,7 +5,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from stabilize.shutter.readout import estimate_readout, readout_for
+from stabilize.shutter.readout import _without, estimate_readout, readout_for
 from tests.stabilize.shutter.helpers import banded_track
 
 
@@ -102,3 +102,24 @@ def test_the_attitude_is_not_fitted_to_repaired_pairs():
 
     assert (off_deg(None) > 2.5).all()  # 2.9 and 3.3 degrees: the junk followed
     assert (off_deg(repaired) < 0.7).all()  # 0.44 and 0.59: bridged by its neighbours
+
+
+def test_at_240_fps_the_readout_is_searched_on_the_strides(fast_walk):
+    # A 240 fps pair turns too little for its bands to date the rows: this global
+    # shutter read 1.7 ± 0.1 ms on them, and its walk's output was corrected by it
+    from stabilize import Settings
+    from stabilize.motion.estimate import READOUT_BANDS
+    from stabilize.motion.focal import estimate_motion
+    from stabilize.video import probe
+
+    track, _ = estimate_motion(fast_walk, probe(fast_walk), Settings(), bands=READOUT_BANDS)
+    assert track.stride_track is not None and track.stride_track.bands is not None
+    on_strides, _ = estimate_readout(track)
+    on_pairs, _ = estimate_readout(replace(track, stride_track=None))
+    assert on_strides.source == "estimated" and on_strides.seconds == 0.0
+    assert on_pairs.seconds > 0.001  # what the pairs alone read, and the test can tell
+    repaired = np.zeros(len(track.rotations), bool)
+    repaired[:16] = True  # the first two strides' pairs: their bands date nothing
+    support = _without(track, repaired).stride_track.band_support
+    assert (support[:, :2] == 0).all()
+    assert (support[:, 2:] == track.stride_track.band_support[:, 2:]).all()
