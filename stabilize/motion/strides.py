@@ -24,6 +24,10 @@ A stride is used only where it can speak for its pairs: its own support is no lo
 a pair's must be (:mod:`stabilize.motion.repair`), every pair it spans looks alike and
 is supported (no cut, interruption or subject winning the vote inside), and its miss
 lies within ``MAX_MISS_DEG``. Elsewhere the pairs stay as voted; the repair sees them.
+
+The focal length is searched on the strides (:mod:`stabilize.motion.focal`), and so is
+a rolling shutter's readout (:mod:`stabilize.shutter.readout`): a 240 fps pair turns too
+little to show either.
 """
 
 from __future__ import annotations
