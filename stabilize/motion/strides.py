@@ -58,6 +58,12 @@ def stride_for(fps: float) -> int:
     return max(1, round(fps / STRIDE_FPS)) if fps > 0 else 1
 
 
+def within(first: int, stop: int, every: int) -> tuple[int, int]:
+    """The strides (j0, j1: j0..j1-1) of ``every`` pairs that lie within frames
+    first..stop-1."""
+    return -(-first // every), (stop - 1) // every
+
+
 def strided_track(
     track: VisualTrack, estimator: HoughEstimator, bands: int = 0
 ) -> VisualTrack | None:

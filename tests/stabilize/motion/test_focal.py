@@ -151,13 +151,15 @@ def test_the_search_spans_the_same_fields_of_view_however_the_camera_is_held(
     assert level[1] == pytest.approx(width / 2 / math.tan(math.radians(7.5)), rel=1e-3)
 
 
-def montage(folder: Path, readout_ms: float = 0.0) -> tuple[Path, dict]:
+def montage(
+    folder: Path, readout_ms: float = 0.0, fps: float = 30.0, seconds: float = 2.0
+) -> tuple[Path, dict]:
     """A rendered 40° clip cut to a rendered 100° one, 2 s each (frames 0-59 | 60-119),
     and the second's true turns."""
     from stabilize.motion.files import read_rotations
     from stabilize.synth import SynthOptions, render_clip
 
-    options = SynthOptions(size=(180, 320), seconds=2.0, shake_deg=1.5, crowd=4)
+    options = SynthOptions(size=(180, 320), seconds=seconds, fps=fps, shake_deg=1.5, crowd=4)
     for name, fov, seed in (("narrow", 40.0, 11), ("wide", 100.0, 12)):
         shot = replace(options, hfov=fov, seed=seed, rolling_shutter_ms=readout_ms)
         render_clip(folder / name, shot)
@@ -191,6 +193,19 @@ def test_a_montage_of_two_cameras_is_voted_shot_by_shot(tmp_path, monkeypatch):
     assert off_deg(track) < 0.15
     monkeypatch.setattr(focal_module, "SHOT_APART", np.inf)  # as before: the clip's alone
     assert off_deg(estimate_motion(clip, info, Settings(), keep_samples=True)[0]) > 0.3
+
+
+def test_a_240_fps_montage_is_searched_shot_by_shot_on_its_strides(tmp_path):
+    # a 240 fps pair turns too little to pin a focal length down: on their pairs
+    # neither shot did, and both were voted at the clip's one
+    from rotation.camera import fov_from_focal
+
+    clip, _ = montage(tmp_path, fps=240.0, seconds=1.5)
+    _, focal = estimate_motion(clip, probe(clip), Settings())
+    assert [first for first, _, _ in focal.shots][-1] == 360
+    px = focal.per_frame(720)
+    assert fov_from_focal(px[0], 320) == pytest.approx(40, rel=0.1)
+    assert fov_from_focal(px[360], 320) == pytest.approx(100, rel=0.05)
 
 
 def test_a_montage_of_two_cameras_is_warped_shot_by_shot(tmp_path):
