@@ -111,6 +111,10 @@ def estimate_rotations(
                 residual.append(_voted(voting, progress))
             if settle and len(found[0]) >= settle.after:  # asked once
                 so_far = _so_far(times, found, residual, kept, estimator, ws)
+                reached = len(found[0]) // every  # the strides the voted pairs span so far
+                if every >= 2 and reached:  # for a high frame rate's search
+                    measured_so_far = _samples(strides[:reached], estimator, ws)
+                    so_far = replace(so_far, strides=measured_so_far, every=every)
                 chosen = settle.choose(so_far)
                 if chosen is not None:
                     estimator, voted, masks = chosen, bands, band_masks(chosen, ws.size[0], bands)

@@ -14,8 +14,9 @@ tripod, pure roll, too little motion) keeps the starting value, and says so, unl
 search's curve rules that value out (:meth:`rotation.focal.FocalEstimate.rules_out`: a
 narrow lens's curve lies flat over the long focal lengths, and reads the 69° default far
 up its steep wide side); then the nearest focal length the curve accepts is taken. At 45
-fps and more the estimate is made at the end, on the clip's strides
-(:mod:`stabilize.motion.strides`), and every pair is then held to them.
+fps and more the estimate is made on the clip's strides (:mod:`stabilize.motion.strides`),
+its first ``MAX_PAIRS`` of them (at the end where it has fewer), and every pair is then
+held to them.
 
 An edited clip (:mod:`stabilize.motion.cuts`) may join shots of two cameras. Each shot of
 at least ``MIN_SHOT_PAIRS`` pairs whose own motion pins a focal length down ``SHOT_APART``
@@ -216,7 +217,7 @@ def estimate_motion(
         return voting_at(resolved.px * ws.scale[0])
 
     def settle(so_far: VisualTrack) -> HoughEstimator | None:
-        found = focal_from_track(so_far, start, long_side).focal
+        found = focal_from_track(strided_track(so_far, start) or so_far, start, long_side).focal
         if found is None:
             return None
         settled.append(_resolved(choice, found / ws.scale[0]))
@@ -226,9 +227,10 @@ def estimate_motion(
         voted = _strides_voted(track, resolved, estimator, voting_at, bands)
         return held_to_strides(track, voted)
 
-    # at a high frame rate the focal length is searched on the strides, at the end: a
-    # pair of a 240 fps clip turns too little to tell its x²/f terms from the flow's
-    # noise (a rendered 240 fps walk read f 43% long on its pairs, within 1% on strides)
+    # at a high frame rate the focal length is searched on the strides, once MAX_PAIRS
+    # of them are measured (4 s at 240 fps), or at the end: a pair of a 240 fps clip
+    # turns too little to tell its x²/f terms from the flow's noise (a rendered 240 fps
+    # walk read f 43% long on its pairs, within 1% on strides)
     track = estimate_rotations(
         path,
         info,
@@ -237,8 +239,8 @@ def estimate_motion(
         times,
         bands=bands,
         lens=lens,
-        keep_samples=keep_samples or (auto and every >= 2),
-        settle=Settle(MAX_PAIRS, settle) if auto and every < 2 else None,
+        keep_samples=keep_samples,
+        settle=Settle(MAX_PAIRS * every, settle) if auto else None,
         every=every,
     )
     if not auto:

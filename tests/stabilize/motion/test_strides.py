@@ -129,3 +129,23 @@ def test_under_a_rolling_shutter_the_similarities_stay_held_to_the_strides(fast_
     per_stride = turns.residual[: count * EVERY].reshape(count, EVERY, 4).sum(axis=1)
     held = track.residual[: count * EVERY].reshape(count, EVERY, 4).sum(axis=1)
     assert np.abs(per_stride - held)[:, 2].mean() < 5e-4
+
+
+def test_a_long_240_fps_clip_settles_its_focal_length_on_the_strides_so_far(fast_walk, monkeypatch):
+    # as a 30 fps clip settles on its first MAX_PAIRS pairs, a 240 fps one settles on its
+    # first MAX_PAIRS strides (4 s), so that the rest is voted once: "long" here once 32
+    # strides (256 pairs of its 359) are measured
+    searched = []
+    search = focal_module.focal_from_track
+
+    def spy(track, estimator, long_side):
+        searched.append(len(track.rotations))
+        return search(track, estimator, long_side)
+
+    monkeypatch.setattr(focal_module, "MAX_PAIRS", 32)
+    monkeypatch.setattr(focal_module, "focal_from_track", spy)
+    _, focal = _truth(fast_walk)
+    track, choice = estimate_motion(fast_walk, probe(fast_walk), Settings())
+    assert searched[0] == 32  # the strides so far, not the pairs (256)
+    assert choice.source == "estimated" and abs(choice.px / focal - 1) < 0.03
+    assert track.samples is None and track.every == EVERY
