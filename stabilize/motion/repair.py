@@ -75,7 +75,7 @@ def repair_unreliable(
     """
     support = np.asarray(support)
     blind = np.zeros(len(R), bool) if unrelated is None else np.asarray(unrelated, bool)
-    supported = support >= max(MIN_SUPPORT, RELATIVE_SUPPORT * float(np.median(support)))
+    supported = support >= support_bar(support)
     # short of support, where support tells pairs apart (some have it, some do not)
     doubtful = ~supported if supported.any() else np.zeros(len(R), bool)
     if not (doubtful.any() or blind.any()) or blind.all():
@@ -113,6 +113,12 @@ def repair_unreliable(
                 continue  # the flow follows the jump: a jolt
         out[k], reliable[k] = repair, False
     return so3.exp_so3(out), reliable
+
+
+def support_bar(support: NDArray) -> float:
+    """The support a vote needs to count among votes of ``support``: ``MIN_SUPPORT``,
+    and ``RELATIVE_SUPPORT`` of their median."""
+    return max(MIN_SUPPORT, RELATIVE_SUPPORT * float(np.median(support)))
 
 
 def repair_track(

@@ -40,7 +40,7 @@ from numpy.typing import NDArray
 from rotation import HoughEstimator, so3
 from stabilize.motion.cuts import ALIKE
 from stabilize.motion.estimate import estimate_again
-from stabilize.motion.repair import MIN_SUPPORT, RELATIVE_SUPPORT
+from stabilize.motion.repair import support_bar
 from stabilize.motion.track import VisualTrack
 
 # The rate strides bring a clip's pairs down to, frames per second: a stride spans a
@@ -110,24 +110,18 @@ def usable(track: VisualTrack, strided: VisualTrack) -> NDArray[np.bool_]:
     """Which strides speak for their pairs (module docstring)."""
     every, count = track.every, len(strided.rotations)
     pairs = slice(0, count * every)
-    supported = (track.support[pairs] >= _bar(track.support)).reshape(count, every)
+    supported = (track.support[pairs] >= support_bar(track.support)).reshape(count, every)
     alike = np.ones((count, every), bool)
     if track.likeness is not None:
         alike = (track.likeness[pairs] >= ALIKE).reshape(count, every)
     chains = np.stack([chain(track.rotations[j * every : (j + 1) * every]) for j in range(count)])
     misses = so3.angle(strided.rotations @ np.swapaxes(chains, -1, -2))
     return (
-        (strided.support >= _bar(strided.support))
+        (strided.support >= support_bar(strided.support))
         & supported.all(axis=1)
         & alike.all(axis=1)
         & (np.degrees(misses) <= MAX_MISS_DEG)
     )
-
-
-def _bar(support: NDArray) -> float:
-    """The support a vote needs to count, among votes of ``support``: a pair's in the
-    repair's sense (:mod:`stabilize.motion.repair`)."""
-    return max(MIN_SUPPORT, RELATIVE_SUPPORT * float(np.median(support)))
 
 
 def chain(R: NDArray) -> NDArray[np.float64]:
