@@ -49,6 +49,7 @@ losslessly both read 1.260 (at the 3 px gate of the time: docs/focal-length.md).
     python bench/real_bench.py --every 2       # every other frame, at half the rate
     python bench/real_bench.py --crf 32        # each clip compressed as a shared clip is
     python bench/real_bench.py --rotation 90   # each clip tagged as a phone held upright
+    python bench/real_bench.py --grain 22      # each clip dim and grainy, as in low light
 
 ``--width`` scales every clip down (FFmpeg, bicubic, CRF 14, limited range) before either
 tool sees it: the literature's "Regular" clips are 640×360, and there the lead is
@@ -63,7 +64,10 @@ surfaces, would show. ``--crf 32`` encodes each view as coarsely as a clip share
 web often is (each view is otherwise CRF 14). ``--rotation 90`` tags each view with that
 display rotation, the stream copied: a phone held upright stores its frames level, with
 its sensor's rows in readout order, and asks the player to turn them (the content then
-shows on its side, which neither tool nor the metric minds).
+shows on its side, which neither tool nor the metric minds). ``--grain 22`` dims each
+view (contrast 0.55, brightness −0.22) and adds temporal noise of that strength (FFmpeg's
+``noise`` filter, its default seed, so every run sees the same grain): a clip shot in
+low light, whose sensor noise the flow sees frame by frame.
 """
 
 from __future__ import annotations
@@ -157,6 +161,9 @@ def main() -> None:
     parser.add_argument(
         "--rotation", type=int, default=0, choices=(0, 90, 180, 270), help="tag each view so"
     )
+    parser.add_argument(
+        "--grain", type=int, default=0, help="dim each view and add noise this strong (0-100)"
+    )
     args = parser.parse_args()
     if args.width is not None and args.width < 16:
         parser.error("--width must be at least 16 px")
@@ -164,7 +171,11 @@ def main() -> None:
         parser.error("--zoom must be between 1 and 8")
     if not 1 <= args.every <= 8:
         parser.error("--every must be between 1 and 8")
-    view = View(args.width, args.zoom or 1.0, args.portrait, args.every, args.crf, args.rotation)
+    if not 0 <= args.grain <= 100:
+        parser.error("--grain must be between 0 and 100")
+    view = View(
+        args.width, args.zoom or 1.0, args.portrait, args.every, args.crf, args.rotation, args.grain
+    )
     work = Path(tempfile.mkdtemp(prefix="real-bench-"))
     ratios, mean_ratios = [], []
     header = (
@@ -221,6 +232,7 @@ class View:
     (a clip stored upright: its long side is its height), then the middle
     1/``zoom`` of each side, scaled to ``width`` (its aspect kept, even sides; None: its
     own width, never up from there), every ``every``-th frame at 1/``every`` the rate,
+    dimmed with temporal noise of strength ``grain`` (0: none; FFmpeg's ``noise``),
     encoded at ``crf`` (x264), then tagged to be shown turned ``rotation``°."""
 
     width: int | None = None
@@ -229,6 +241,11 @@ class View:
     every: int = 1
     crf: int = VIEW_CRF
     rotation: int = 0
+    grain: int = 0
+
+
+# A dim view's levels (FFmpeg's eq): its grain then stands out as a low-light clip's does
+DIM = "eq=brightness=-0.22:contrast=0.55"
 
 
 def viewed(clip: Path, dst: Path, view: View) -> Path:
@@ -250,6 +267,7 @@ def viewed(clip: Path, dst: Path, view: View) -> Path:
         every = view.every
         sparse = f"select=not(mod(n\\,{every})),setpts=N/({rate}*TB)," if every > 1 else ""
         chain = f"{sparse}{upright}{crop}scale={out}:-2:flags=bicubic"
+        chain += f",{DIM},noise=alls={view.grain}:allf=t+u" if view.grain else ""
         cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-map", "0:v:0", "-vf", chain]
         codec = ["-r", f"{rate}", "-c:v", "libx264", "-crf", str(view.crf)]
         codec += ["-pix_fmt", "yuv420p", "-an"]

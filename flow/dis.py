@@ -5,13 +5,14 @@ from __future__ import annotations
 import threading
 from collections import deque
 from collections.abc import Iterable, Iterator
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 
 import cv2
 import numpy as np
 from numpy.typing import NDArray
 
 from flow.base import check_frame, check_pair, to_grey
+from flow.grain import noise_level, through_grain
 
 # A preset's name → (OpenCV's preset, the finest pyramid level the flow is refined at).
 # OpenCV's own "fast" stops at level 2, a quarter of the working size (120 px across at
@@ -45,8 +46,9 @@ class DISFlow:
         self._local = threading.local()  # an instance per thread: they hold scratch state
 
     def __call__(self, frame0: NDArray, frame1: NDArray) -> NDArray[np.float32]:
-        frame0, frame1 = check_pair(frame0, frame1)
-        return self._flow(self._dis, to_grey(frame0), to_grey(frame1))
+        grey0, grey1 = (to_grey(frame) for frame in check_pair(frame0, frame1))
+        pair = through_grain(grey0, grey1, noise_level(grey0), noise_level(grey1))
+        return self._flow(self._dis, *pair)
 
     def many(self, frames: Iterable[NDArray]) -> Iterator[NDArray[np.float32]]:
         """The flows of consecutive pairs, in order, several pairs computed at once.
@@ -59,21 +61,23 @@ class DISFlow:
         threads = cv2.getNumThreads()  # handed back as found
         workers = max(1, threads)
         pending: deque = deque()
-        previous = None
+        previous, previous_noise = None, None
         cv2.setNumThreads(1)
         try:
             with ThreadPoolExecutor(workers, thread_name_prefix="dis") as pool:
                 for frame in frames:
                     grey = to_grey(check_frame(frame))
+                    noise = pool.submit(noise_level, grey)  # each frame's once (flow.grain)
                     if previous is not None:
                         if grey.shape != previous.shape:
                             raise ValueError(
                                 f"frame sizes differ: {previous.shape[::-1]} and {grey.shape[::-1]}"
                             )
-                        pending.append(pool.submit(self._flow_here, previous, grey))
+                        pair = (previous, grey, previous_noise, noise)
+                        pending.append(pool.submit(self._flow_here, *pair))
                         if len(pending) > 2 * workers:
                             yield pending.popleft().result()
-                    previous = grey
+                    previous, previous_noise = grey, noise
                 while pending:
                     yield pending.popleft().result()
         finally:
@@ -85,11 +89,15 @@ class DISFlow:
         dis.setFinestScale(finest)
         return dis
 
-    def _flow_here(self, grey0: NDArray[np.uint8], grey1: NDArray[np.uint8]) -> NDArray:
-        """The flow, by this thread's own instance."""
+    def _flow_here(
+        self, grey0: NDArray[np.uint8], grey1: NDArray[np.uint8], noise0: Future, noise1: Future
+    ) -> NDArray:
+        """The flow, by this thread's own instance, through the pair's grain (its
+        frames' noise levels, read on the pool before the pair was queued)."""
         if not hasattr(self._local, "dis"):
             self._local.dis = self._create()
-        return self._flow(self._local.dis, grey0, grey1)
+        pair = through_grain(grey0, grey1, noise0.result(), noise1.result())
+        return self._flow(self._local.dis, *pair)
 
     @staticmethod
     def _flow(dis: cv2.DISOpticalFlow, grey0: NDArray, grey1: NDArray) -> NDArray[np.float32]:

@@ -164,27 +164,19 @@ def test_a_readout_the_bands_do_not_pin_down_is_said_to_be_so(rolling_clip):
     assert "readout 0.0 ms (not pinned down by the bands" in result.stdout
 
 
+def _phone_cc9_against_its_gyro(data, frames: str) -> dict:
+    """``stabilize compare`` of phone-cc9's frames (``frames``: a pattern, numbered from
+    99) against its gyro, at its calibrated focal length: the JSON summary."""
+    options = ["--start-number", "99", "--gyro", str(data / "gyro.txt")]
+    options += ["--timestamps", str(data / "framestamp.txt"), "--focal", "573.85"]
+    result = CliRunner().invoke(app, ["compare", frames, *options, "-q", "--json"])
+    assert result.exit_code == 0, result.output
+    return json.loads(result.stdout)
+
+
 def test_phone_cc9_offset_axes_and_readout(shared):
     data = shared / "data" / "phone-cc9"
-    result = CliRunner().invoke(
-        app,
-        [
-            "compare",
-            str(data / "frames" / "RE_frame-%d.jpg"),
-            "--start-number",
-            "99",
-            "--gyro",
-            str(data / "gyro.txt"),
-            "--timestamps",
-            str(data / "framestamp.txt"),
-            "--focal",
-            "573.85",
-            "-q",
-            "--json",
-        ],
-    )
-    assert result.exit_code == 0, result.output
-    summary = json.loads(result.stdout)
+    summary = _phone_cc9_against_its_gyro(data, str(data / "frames" / "RE_frame-%d.jpg"))
     # The data README: offset 0 ± 4 ms from the frame start; gyro x is camera y and
     # gyro y camera x.
     assert abs(summary["offset_s"]) < 4e-3
@@ -193,6 +185,25 @@ def test_phone_cc9_offset_axes_and_readout(shared):
     # 0.057° with only textured vectors voting, 0.090° with every vector (flow.texture)
     assert summary["aae_deg"] < 0.07 and summary["warning"] is None
     assert 0.9 < summary["motion_scale"] < 1.1
+
+
+def test_phone_cc9_in_low_light_is_read_through_its_grain(shared, tmp_path):
+    """phone-cc9's frames dimmed (contrast 0.55, brightness -0.22) and grained (Gaussian
+    σ 8 grey levels, new each frame), against its gyro: the flow blurred through the
+    grain (flow.grain) reads 0.078° of mean error where DIS on the raw frames read 0.109°
+    (another seed: 0.077 against 0.104; the clean frames 0.057)."""
+    import cv2
+
+    data = shared / "data" / "phone-cc9"
+    rng = np.random.default_rng(1)
+    for n in range(99, 202):
+        frame = cv2.imread(str(data / "frames" / f"RE_frame-{n}.jpg")).astype(np.float32)
+        frame = (frame - 128) * 0.55 + 128 - 0.22 * 255
+        frame += rng.normal(0, 8.0, frame.shape[:2])[..., None]
+        grained = np.clip(frame, 0, 255).round().astype(np.uint8)
+        cv2.imwrite(str(tmp_path / f"RE_frame-{n}.png"), grained)
+    summary = _phone_cc9_against_its_gyro(data, str(tmp_path / "RE_frame-%d.png"))
+    assert summary["aae_deg"] < 0.09
 
 
 def test_a_linear_clock_drift_is_fitted(sample):
