@@ -50,6 +50,7 @@ losslessly both read 1.260 (at the 3 px gate of the time: docs/focal-length.md).
     python bench/real_bench.py --crf 32        # each clip compressed as a shared clip is
     python bench/real_bench.py --rotation 90   # each clip tagged as a phone held upright
     python bench/real_bench.py --grain 22      # each clip dim and grainy, as in low light
+    python bench/real_bench.py --measured      # and the metric's own readings undone
 
 ``--width`` scales every clip down (FFmpeg, bicubic, CRF 14, limited range) before either
 tool sees it: the literature's "Regular" clips are 640×360, and there the lead is
@@ -68,6 +69,13 @@ shows on its side, which neither tool nor the metric minds). ``--grain 22`` dims
 view (contrast 0.55, brightness −0.22) and adds temporal noise of that strength (FFmpeg's
 ``noise`` filter, its default seed, so every run sees the same grain): a clip shot in
 low light, whose sensor noise the flow sees frame by frame.
+
+``--measured`` adds a row: the original with the high-passed motion the metric reads on
+it undone frame by frame, at vid.stab's crop (:func:`measured_undone`). Where the
+registration's own readings are noisy, undoing them adds their noise: on hero7, karma,
+max-heromode and phone-cc9's frames the row's zoom part reads 26–58% above the crop
+alone's, so what the metric reads as zoom there is mostly its own noise
+(docs/real-footage.md).
 """
 
 from __future__ import annotations
@@ -81,6 +89,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import cv2
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -164,6 +173,11 @@ def main() -> None:
     parser.add_argument(
         "--grain", type=int, default=0, help="dim each view and add noise this strong (0-100)"
     )
+    parser.add_argument(
+        "--measured",
+        action="store_true",
+        help="also the original with the shake the metric measures on it undone",
+    )
     args = parser.parse_args()
     if args.width is not None and args.width < 16:
         parser.error("--width must be at least 16 px")
@@ -202,9 +216,20 @@ def main() -> None:
             clip, work / f"{tag}_crop.mp4", theirs_m.cropping_ratio, info.size, args.out_crf
         )
         _, crop_m = evaluate_pair(read_frames(clip), read_frames(crop, info.size), fps)
+        reference = [("original", original, None), ("crop only", crop_m, None)]
+        if args.measured:
+            undone = measured_undone(
+                clip,
+                work / f"{tag}_measured.mp4",
+                theirs_m.cropping_ratio,
+                info.size,
+                fps,
+                args.out_crf,
+            )
+            _, undone_m = evaluate_pair(read_frames(clip), read_frames(undone, info.size), fps)
+            reference.append(("measured", undone_m, None))
         for tool, m, t in (
-            ("original", original, None),
-            ("crop only", crop_m, None),
+            *reference,
             ("ours", ours_m, t_ours),
             ("vid.stab", theirs_m, t_vs),
         ):
@@ -292,6 +317,39 @@ def crop_only(clip: Path, dst: Path, ratio: float, size: tuple[int, int], crf: i
     view = f"{middle(w, h, ratio)},scale={w}:{h}:flags=bicubic"
     cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-vf", view, *encoder(crf), "-an"]
     subprocess.run([*cmd, str(dst)], check=True)
+    return dst
+
+
+def measured_undone(
+    clip: Path, dst: Path, ratio: float, size: tuple[int, int], fps: float, crf: int
+) -> Path:
+    """``clip`` with the shake the metric measures on it undone, at ``dst``: frame t moved
+    by the similarity -Σ_{k<t} h_k, h_k the high-passed frame-to-frame motion the metric
+    reads on the original (``shake_series``: dx, dy at the frame's middle, roll and zoom in
+    px at the width), about the frame's middle, then cropped to ``ratio`` as
+    :func:`crop_only` is and encoded as both tools' output is. What a 2-D stabiliser that
+    knew the metric's own readings would make of the clip: where the registration's
+    readings are themselves noisy, undoing them adds that noise."""
+    h, w = size
+    shake = evaluate(read_frames(clip, size), fps).shake_series
+    undo = np.vstack([np.zeros(4), -np.cumsum(shake, axis=0)])
+    middle_px = np.array([(w - 1) / 2, (h - 1) / 2])
+    source = ["-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{w}x{h}", "-r", f"{fps}", "-i", "-"]
+    cmd = [ffmpeg_exe(), "-v", "error", "-y", *source, *encoder(crf), str(dst)]
+    with subprocess.Popen(cmd, stdin=subprocess.PIPE) as pipe:
+        assert pipe.stdin is not None
+        for frame, (dx, dy, roll, zoom) in zip(read_frames(clip, size), undo, strict=False):
+            angle, scale = roll * 2 / w, np.exp(zoom * 2 / w) / ratio
+            c, s = scale * np.cos(angle), scale * np.sin(angle)
+            A = np.array([[c, -s], [s, c]])  # about the middle, then the crop's zoom
+            shift = middle_px - A @ middle_px + np.array([dx, dy]) / ratio
+            warped = cv2.warpAffine(
+                frame, np.c_[A, shift], (w, h), borderMode=cv2.BORDER_REFLECT_101
+            )
+            pipe.stdin.write(np.ascontiguousarray(warped).tobytes())
+        pipe.stdin.close()
+    if pipe.returncode:
+        raise RuntimeError(f"FFmpeg failed writing {dst}")
     return dst
 
 
