@@ -95,7 +95,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from stabilize_bench import OUT_CRF, crf_option, encoder, timed, vidstab
 
-from stabilize.evaluate.metrics import evaluate, evaluate_against, evaluate_pair
+from stabilize.evaluate.metrics import evaluate, evaluate_against, evaluate_pair, shake_spread
 from stabilize.evaluate.plot import plot_shake
 from stabilize.video import ffmpeg_exe, probe, read_frames
 
@@ -353,19 +353,10 @@ def measured_undone(
     return dst
 
 
-# Mirrorings that keep every frame-to-frame motion's size: left-right, upside down, both.
-FLIP = slice(None, None, -1)
-MIRRORS = ((slice(None), FLIP), (FLIP,), (FLIP, FLIP))
-
-
 def mirrored(out: Path, size: tuple[int, int], fps: float, m) -> list[float]:
-    """The residual shake (px) of ``out`` as it is (``m``), and under each of
-    ``MIRRORS``."""
-    readings = [m.residual_shake_px]
-    for mirror in MIRRORS:
-        frames = (np.ascontiguousarray(frame[mirror]) for frame in read_frames(out, size))
-        readings.append(evaluate(frames, fps).residual_shake_px)
-    return readings
+    """The residual shake (px) of ``out`` as it is (``m``), and mirrored left-right,
+    upside down and both (:func:`stabilize.evaluate.shake_spread`)."""
+    return list(shake_spread(read_frames(out, size), m.residual_shake_px, fps).readings)
 
 
 def span(readings: list[float]) -> str:

@@ -1,6 +1,20 @@
 """Judging a result: the literature's quality metrics, the run's report, and the visual
 estimate against a gyroscope."""
 
-from stabilize.evaluate.metrics import ClipMetrics, evaluate, evaluate_against, evaluate_pair
+from stabilize.evaluate.metrics import (
+    ClipMetrics,
+    Spread,
+    evaluate,
+    evaluate_against,
+    evaluate_pair,
+    shake_spread,
+)
 
-__all__ = ["ClipMetrics", "evaluate", "evaluate_against", "evaluate_pair"]
+__all__ = [
+    "ClipMetrics",
+    "Spread",
+    "evaluate",
+    "evaluate_against",
+    "evaluate_pair",
+    "shake_spread",
+]

@@ -39,6 +39,23 @@ def test_evaluate_command(sample):
     assert bad.exit_code != 0 and "not a video" in bad.output
 
 
+def test_evaluate_reads_the_shake_mirrored_too(sample):
+    result = CliRunner().invoke(app, ["evaluate", sample, sample, "--spread", "--json", "-q"])
+    assert result.exit_code == 0, result.output
+    metrics = json.loads(result.stdout)
+    for clip in ("original", "stabilised"):
+        spread = metrics[clip]["residual_shake_spread_px"]
+        assert spread["readings"][0] == metrics[clip]["residual_shake_px"]
+        assert len(spread["readings"]) == 4
+        assert spread["min"] <= spread["mean"] <= spread["max"]
+    # the same clip twice: the same four readings
+    assert metrics["original"]["residual_shake_spread_px"] == pytest.approx(
+        metrics["stabilised"]["residual_shake_spread_px"]
+    )
+    text = CliRunner().invoke(app, ["evaluate", sample, sample, "--spread", "-q"])
+    assert text.exit_code == 0 and "residual shake mirrored (px): original" in text.stdout
+
+
 def test_evaluate_draws_the_shake(sample, tmp_path):
     png = tmp_path / "shake.png"
     result = CliRunner().invoke(app, ["evaluate", sample, sample, "--plot", str(png), "-q"])

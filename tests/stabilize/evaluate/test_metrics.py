@@ -8,6 +8,7 @@ from stabilize.evaluate.metrics import (
     evaluate_pair,
     low_frequency_share,
     scale_and_distortion,
+    shake_spread,
 )
 from stabilize.synth import SynthOptions, render_frames
 
@@ -46,6 +47,24 @@ def test_the_residual_shake_is_in_pixels_of_the_motion(shaken):
     jittered = [np.roll(shaken[0], 2 * (k % 2), axis=1) for k in range(60)]
     cropped = [f[:, 8:-8] for f in jittered]
     assert evaluate(cropped).residual_shake_px == pytest.approx(2.0, rel=0.1)
+
+
+def test_the_spread_reads_the_same_motion_mirrored(shaken):
+    # The 2 px jitter above: mirrored left-right, upside down or both it is still ±2 px
+    # from frame to frame, so every reading is 2 px; the features are other ones.
+    jittered = [np.roll(shaken[0], 2 * (k % 2), axis=1)[:, 8:-8] for k in range(60)]
+    as_it_is = evaluate(jittered).residual_shake_px
+    spread = shake_spread(jittered, as_it_is)
+    assert spread.readings[0] == as_it_is and len(spread.readings) == 4
+    assert spread.readings == pytest.approx([2.0] * 4, rel=0.1)
+    # On the shaken street the readings agree within the metric's noise, yet are other
+    # registrations (not the same frames read four times)
+    shaky = evaluate(shaken).residual_shake_px
+    readings = shake_spread(shaken, shaky).readings
+    assert readings == pytest.approx([shaky] * 4, rel=0.1) and len(set(readings)) > 1
+    figures = shake_spread(shaken, shaky).as_dict()
+    assert figures["min"] <= figures["mean"] <= figures["max"]
+    assert figures["mean"] == pytest.approx(np.mean(readings))
 
 
 def test_a_zoomed_crop_ranks_below_an_uncropped_one(shaken):
