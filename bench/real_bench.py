@@ -46,6 +46,7 @@ losslessly both read 1.260 (at the 3 px gate of the time: docs/focal-length.md).
     python bench/real_bench.py --width 640     # each clip scaled down first (640×360)
     python bench/real_bench.py --zoom 2        # each clip's middle half, at its own size
     python bench/real_bench.py --portrait      # each clip's middle 9:16, upright
+    python bench/real_bench.py --turned        # each clip turned a quarter, baked in
     python bench/real_bench.py --every 2       # every other frame, at half the rate
     python bench/real_bench.py --crf 32        # each clip compressed as a shared clip is
     python bench/real_bench.py --rotation 90   # each clip tagged as a phone held upright
@@ -69,6 +70,10 @@ shows on its side, which neither tool nor the metric minds). ``--grain 22`` dims
 view (contrast 0.55, brightness −0.22) and adds temporal noise of that strength (FFmpeg's
 ``noise`` filter, its default seed, so every run sees the same grain): a clip shot in
 low light, whose sensor noise the flow sees frame by frame.
+``--turned`` turns each clip a quarter clockwise and stores it so, with no display
+rotation: a messenger's or an editor's copy of a clip shot with the phone upright, whose
+sensor's rows (read out one after another under a rolling shutter) now run down the
+frame's columns, where the tool's readout model expects rows.
 
 ``--measured`` adds a row: the original with the high-passed motion the metric reads on
 it undone frame by frame, at vid.stab's crop (:func:`measured_undone`). Where the
@@ -160,6 +165,9 @@ def main() -> None:
     parser.add_argument(
         "--portrait", action="store_true", help="keep each clip's middle 9:16 first (upright)"
     )
+    parser.add_argument(
+        "--turned", action="store_true", help="turn each clip a quarter clockwise, baked in"
+    )
     parser.add_argument("--every", type=int, default=1, help="keep every EVERY-th frame first")
     parser.add_argument(
         "--crf", type=crf_option, default=VIEW_CRF, help="encode each view at this CRF"
@@ -188,7 +196,14 @@ def main() -> None:
     if not 0 <= args.grain <= 100:
         parser.error("--grain must be between 0 and 100")
     view = View(
-        args.width, args.zoom or 1.0, args.portrait, args.every, args.crf, args.rotation, args.grain
+        args.width,
+        args.zoom or 1.0,
+        args.portrait,
+        args.every,
+        args.crf,
+        args.rotation,
+        args.grain,
+        args.turned,
     )
     work = Path(tempfile.mkdtemp(prefix="real-bench-"))
     ratios, mean_ratios = [], []
@@ -256,9 +271,10 @@ class View:
     """How the bench sees a clip: with ``portrait`` its middle 9:16 of the frame's height
     (a clip stored upright: its long side is its height), then the middle
     1/``zoom`` of each side, scaled to ``width`` (its aspect kept, even sides; None: its
-    own width, never up from there), every ``every``-th frame at 1/``every`` the rate,
-    dimmed with temporal noise of strength ``grain`` (0: none; FFmpeg's ``noise``),
-    encoded at ``crf`` (x264), then tagged to be shown turned ``rotation``°."""
+    own width, never up from there), turned a quarter clockwise where ``turned`` (baked
+    in), every ``every``-th frame at 1/``every`` the rate, dimmed with temporal noise of
+    strength ``grain`` (0: none; FFmpeg's ``noise``), encoded at ``crf`` (x264), then
+    tagged to be shown turned ``rotation``°."""
 
     width: int | None = None
     zoom: float = 1.0
@@ -267,6 +283,7 @@ class View:
     crf: int = VIEW_CRF
     rotation: int = 0
     grain: int = 0
+    turned: bool = False
 
 
 # A dim view's levels (FFmpeg's eq): its grain then stands out as a low-light clip's does
@@ -292,6 +309,7 @@ def viewed(clip: Path, dst: Path, view: View) -> Path:
         every = view.every
         sparse = f"select=not(mod(n\\,{every})),setpts=N/({rate}*TB)," if every > 1 else ""
         chain = f"{sparse}{upright}{crop}scale={out}:-2:flags=bicubic"
+        chain += ",transpose=clock" if view.turned else ""
         chain += f",{DIM},noise=alls={view.grain}:allf=t+u" if view.grain else ""
         cmd = [ffmpeg_exe(), "-v", "error", "-y", "-i", str(clip), "-map", "0:v:0", "-vf", chain]
         codec = ["-r", f"{rate}", "-c:v", "libx264", "-crf", str(view.crf)]
