@@ -135,8 +135,8 @@ def evaluate(
         a, b = (_formatted(fmt, result[clip][key]) for clip in ("original", "stabilised"))
         typer.echo(f"{label:26s}{a:>12s}{b:>{max(12, len(b) + 1)}s}")
     if spread:
-        low_high = [result[c]["residual_shake_spread_px"] for c in ("original", "stabilised")]
-        a, b = (f"{x['mean']:.3f} ({x['min']:.3f}–{x['max']:.3f})" for x in low_high)
+        spreads = [result[c]["residual_shake_spread_px"] for c in ("original", "stabilised")]
+        a, b = (f"{x['mean']:.3f} ({x['min']:.3f}–{x['max']:.3f})" for x in spreads)
         typer.echo(f"residual shake mirrored (px): original {a}, stabilised {b}")
     if "rotations" in result:
         r = result["rotations"]

@@ -3,7 +3,7 @@ estimate against a gyroscope."""
 
 from stabilize.evaluate.metrics import (
     ClipMetrics,
-    Spread,
+    ShakeSpread,
     evaluate,
     evaluate_against,
     evaluate_pair,
@@ -12,7 +12,7 @@ from stabilize.evaluate.metrics import (
 
 __all__ = [
     "ClipMetrics",
-    "Spread",
+    "ShakeSpread",
     "evaluate",
     "evaluate_against",
     "evaluate_pair",

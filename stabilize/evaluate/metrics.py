@@ -338,7 +338,7 @@ MIRRORS: dict[str, tuple[slice, ...]] = {
 
 
 @dataclass(frozen=True)
-class Spread:
+class ShakeSpread:
     """A clip's residual shake (px) read as it is and under each of :data:`MIRRORS`.
 
     Mirroring moves every feature but changes no motion's size, so the shake is the same;
@@ -364,8 +364,8 @@ def shake_spread(
     as_it_is: float,
     fps: float = 30.0,
     progress: Progress = no_progress,
-) -> Spread:
-    """The :class:`Spread` of a clip whose residual shake reads ``as_it_is`` (px): its
+) -> ShakeSpread:
+    """The :class:`ShakeSpread` of a clip whose residual shake reads ``as_it_is`` (px): its
     frames registered under every mirroring, in one pass; ``progress(1)`` after each."""
     clips = [_Clip() for _ in MIRRORS]
     for frame in frames:
@@ -373,4 +373,4 @@ def shake_spread(
             clip.add(np.ascontiguousarray(frame[mirror]))
         progress(1)
     readings = (as_it_is, *(c.metrics([], [], fps).residual_shake_px for c in clips))
-    return Spread(tuple(float(r) for r in readings))
+    return ShakeSpread(tuple(float(r) for r in readings))

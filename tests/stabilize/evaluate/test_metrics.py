@@ -60,9 +60,9 @@ def test_the_spread_reads_the_same_motion_mirrored(shaken):
     # On the shaken street the readings agree within the metric's noise, yet are other
     # registrations (not the same frames read four times)
     shaky = evaluate(shaken).residual_shake_px
-    readings = shake_spread(shaken, shaky).readings
+    street = shake_spread(shaken, shaky)
+    readings, figures = street.readings, street.as_dict()
     assert readings == pytest.approx([shaky] * 4, rel=0.1) and len(set(readings)) > 1
-    figures = shake_spread(shaken, shaky).as_dict()
     assert figures["min"] <= figures["mean"] <= figures["max"]
     assert figures["mean"] == pytest.approx(np.mean(readings))
 
