@@ -218,7 +218,13 @@ class FrameWriter:
             self._process.stdin.close()
         except (BrokenPipeError, OSError):
             pass
-        if self._process.wait() != 0:
+        try:
+            code = self._process.wait()
+        except BaseException:  # an interrupt while FFmpeg finishes the file: left running,
+            self._process.kill()  # it would write it again after the caller removed it
+            self._process.wait()  # (MP4's faststart pass reopens it by name)
+            raise
+        if code != 0:
             raise self._failure()
         self._said()
 
