@@ -200,8 +200,7 @@ class FrameWriter:
             self._said = drain(self._process.stderr)  # (a damaged source's audio says much)
             widen_pipe(self._process.stdin)
         except BaseException:  # an interrupt before `with` takes it: FFmpeg left running
-            self._process.kill()  # wrote its file after the caller had removed it
-            self._process.wait()
+            self._stop()  # wrote its file after the caller had removed it
             raise
 
     def write(self, frame: NDArray[np.uint8]) -> None:
@@ -221,9 +220,8 @@ class FrameWriter:
         try:
             code = self._process.wait()
         except BaseException:  # an interrupt while FFmpeg finishes the file: left running,
-            self._process.kill()  # it would write it again after the caller removed it
-            self._process.wait()  # (MP4's faststart pass reopens it by name)
-            raise
+            self._stop()  # it would write it again after the caller removed it (MP4's
+            raise  # faststart pass reopens it by name)
         if code != 0:
             raise self._failure()
         self._said()
@@ -235,6 +233,11 @@ class FrameWriter:
         self._process.wait()
         return EncodeError(encoder_message(err, self._process.returncode))
 
+    def _stop(self) -> None:
+        """End the encoder at once and reap it: nothing it would write is wanted."""
+        self._process.kill()
+        self._process.wait()
+
     def __enter__(self) -> FrameWriter:
         return self
 
@@ -242,8 +245,7 @@ class FrameWriter:
         if exc_type is None:
             self.close()
         else:
-            self._process.kill()
-            self._process.wait()
+            self._stop()
 
 
 def encoder_message(stderr: str, code: int | None) -> str:
