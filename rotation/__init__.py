@@ -11,9 +11,10 @@ The estimator (numba kernels) loads when first used, so ``rotation.so3`` and
 
 import importlib
 
-from rotation.cache import use_cache_dir
+from rotation.cache import use_cache_dir, use_plain_messages
 
 use_cache_dir()  # before any kernel is defined: cached in the user's folder
+use_plain_messages()  # and numba's messages leave sys.stdout and sys.stderr alone
 
 from rotation import camera, so3  # noqa: E402
 

@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 import rotation
 from rotation.cache import cache_dir
 
@@ -29,3 +31,20 @@ def test_numba_is_pointed_there_before_any_kernel_is_defined(tmp_path):
     code = "import rotation; from numba.core import config; print(config.CACHE_DIR)"
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert out.stdout.strip() == str(tmp_path / "numba"), out.stderr
+
+
+def test_numba_formats_its_messages_without_rebinding_the_standard_streams():
+    # colorama's init()/deinit() around each message numba formats while compiling
+    # rebound sys.stderr 32,601 times in one first compile, from the compiling thread
+    pytest.importorskip("colorama")  # (without it numba leaves the streams alone)
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING"}
+    code = (
+        "import rotation, colorama\n"
+        "calls = []\n"
+        "colorama.init = colorama.deinit = lambda *a, **k: calls.append(1)\n"
+        "from numba.core import errors\n"
+        "errors.termcolor().highlight('a message')\n"
+        "print(len(calls))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.stdout.strip() == "0", out.stderr
