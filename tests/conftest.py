@@ -6,6 +6,12 @@ from pathlib import Path
 
 import pytest
 
+# numba's settings (rotation.cache: the cache folder, plain messages) before any test
+# module loads numba: flow.texture and stabilize.gyro.integrate load it without rotation,
+# and a numba loaded first colours its messages through colorama, which rebinds
+# sys.stderr from the thread that compiles (tests found capsys emptied)
+import rotation  # noqa: F401
+
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 
 
