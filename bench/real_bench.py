@@ -196,14 +196,14 @@ def main() -> None:
     if not 0 <= args.grain <= 100:
         parser.error("--grain must be between 0 and 100")
     view = View(
-        args.width,
-        args.zoom or 1.0,
-        args.portrait,
-        args.every,
-        args.crf,
-        args.rotation,
-        args.grain,
-        args.turned,
+        width=args.width,
+        zoom=args.zoom or 1.0,
+        portrait=args.portrait,
+        every=args.every,
+        crf=args.crf,
+        rotation=args.rotation,
+        grain=args.grain,
+        turned=args.turned,
     )
     work = Path(tempfile.mkdtemp(prefix="real-bench-"))
     ratios, mean_ratios = [], []
