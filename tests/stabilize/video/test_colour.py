@@ -11,7 +11,6 @@ import pytest
 from numpy.typing import NDArray
 
 from stabilize import Settings, stabilize_video
-from stabilize.pipeline import dolby_vision_notice
 from stabilize.video import Encoding, ffmpeg_exe, probe, read_frames
 from stabilize.video.colour import Colour, colour_of
 from stabilize.video.i420 import black
@@ -175,20 +174,6 @@ def test_hdr10_plus_left_out_is_said(shaky, tmp_path):
     assert probe(clip).colour.hdr10_plus and not probe(shaky).colour.hdr10_plus
     summary, _ = stabilize_video(clip, tmp_path / "out.mp4", Settings(fov=70.0))
     assert any(n.startswith("HDR10+ (its tone mapping") for n in summary["notices"])
-
-
-@pytest.mark.parametrize(
-    ("profile", "said"),
-    [
-        ("8.4", "its HLG picture is kept"),  # an iPhone's HDR clip
-        ("8.1", "its HDR10 picture is kept"),
-        ("5.0", "Dolby's own colours, which look wrong"),  # no picture outside it
-    ],
-)
-def test_dolby_vision_left_out_is_said_with_what_its_picture_is(profile, said):
-    (notice,) = dolby_vision_notice(profile)
-    assert notice.startswith(f"Dolby Vision (profile {profile}) left out") and said in notice
-    assert dolby_vision_notice(None) == ()
 
 
 IPHONE_HDR = """Input #0, mov,mp4,m4a,3gp,3g2,mj2, from 'IMG_0001.MOV':
