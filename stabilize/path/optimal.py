@@ -416,15 +416,23 @@ def _stacked(*systems: tuple[sparse.csr_array, NDArray]) -> tuple[sparse.csr_arr
     return sparse.vstack([A for A, _ in systems]).tocsr(), np.concatenate([b for _, b in systems])
 
 
-def shake_operator(n: int, k: int, sigma: float) -> sparse.csr_array:
-    """(I - G_σ) Δ ⊗ I_k: the high-passed velocity of a path of n frames and k
-    components, flattened frame-major (G_σ a Gaussian of σ frames, ends held)."""
+def high_passed_velocity(n: int, sigma: float) -> NDArray[np.float64]:
+    """(I - G_σ) Δ, dense (n - 1, n): the high-passed velocity of a path of n frames
+    (G_σ a Gaussian of σ frames, ends held)."""
     from scipy.ndimage import gaussian_filter1d
 
     eye = np.eye(n - 1)
     high = eye - gaussian_filter1d(eye, max(sigma, 1.0), axis=0, mode="nearest")
-    step = sparse.diags_array([-1.0, 1.0], offsets=[0, 1], shape=(n - 1, n))
-    return sparse.kron(sparse.csr_array(high) @ step, sparse.eye_array(k)).tocsr()
+    B = np.zeros((n - 1, n))
+    B[:, 1:] += high  # frame i + 1 of step i
+    B[:, :-1] -= high  # less frame i
+    return B
+
+
+def shake_operator(n: int, k: int, sigma: float) -> sparse.csr_array:
+    """(I - G_σ) Δ ⊗ I_k: the high-passed velocity of a path of n frames and k
+    components, flattened frame-major (:func:`high_passed_velocity`)."""
+    return sparse.kron(high_passed_velocity(n, sigma), sparse.eye_array(k)).tocsr()
 
 
 def _shake_cost(
@@ -438,15 +446,19 @@ def _shake_cost(
     is about 1e-7, where Clarabel's absolute tolerances (1e-8) end the solve early: on
     karma 0.03–0.1% above the optimum, the path up to 0.4 px off it. P is given as its
     upper triangle, the form Clarabel takes, made once for every solve of the window.
+    With H = B ⊗ I_k (:func:`shake_operator`), HᵀH = BᵀB ⊗ I_k: the components do not
+    meet in the cost, so BᵀB is made dense, n × n, and spread over them. The sparse
+    product HᵀH took 0.40 s a window of 300 frames and 7 components (240 fps), this 0.04.
     """
     n, k = p0.shape
     if n < 3:
         return None
-    H = shake_operator(n, k, sigma)
-    shake = H @ p0.ravel()
-    unit = max(0.5 * float(shake @ shake), STILL * n * k)
-    P = (H.T @ H + hold * sparse.eye_array(n * k)) / unit
-    return sparse.triu(P).tocsc(), H.T @ shake / unit
+    B = high_passed_velocity(n, sigma)
+    shake = B @ p0  # (n - 1, k)
+    unit = max(0.5 * float(np.sum(shake * shake)), STILL * n * k)
+    M = np.triu(B.T @ B + hold * np.eye(n)) / unit
+    P = sparse.kron(sparse.csr_array(M), sparse.eye_array(k))
+    return P.tocsc(), (B.T @ shake).ravel() / unit
 
 
 def _programme(
