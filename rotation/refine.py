@@ -92,9 +92,31 @@ def gauss_newton_step(x, y, qx, qy, f, R, w) -> np.ndarray:
             g[r] += w[i] * (J[0, r] * ex + J[1, r] * ey)
             for c in range(3):
                 H[r, c] += w[i] * (J[0, r] * J[0, c] + J[1, r] * J[1, c])
-    if abs(np.linalg.det(H)) < 1e-30:
-        return np.zeros(3)
-    return -np.linalg.solve(H, g)
+    return -solve3(H, g)
+
+
+@njit(cache=True)
+def solve3(H: np.ndarray, g: np.ndarray) -> np.ndarray:
+    """H⁻¹ g for a 3×3 H by its adjugate, H⁻¹ = adj(H) / det(H); zero where |det H| <
+    1e-30 (ill-posed). Written out rather than ``np.linalg.solve``, whose LAPACK binding
+    took 4.1 s of a fresh install's first compile (the kernels' 20 s), for a 3×3 system."""
+    c00 = H[1, 1] * H[2, 2] - H[1, 2] * H[2, 1]
+    c01 = H[1, 2] * H[2, 0] - H[1, 0] * H[2, 2]
+    c02 = H[1, 0] * H[2, 1] - H[1, 1] * H[2, 0]
+    det = H[0, 0] * c00 + H[0, 1] * c01 + H[0, 2] * c02
+    out = np.zeros(3)
+    if abs(det) < 1e-30:
+        return out
+    c10 = H[0, 2] * H[2, 1] - H[0, 1] * H[2, 2]
+    c11 = H[0, 0] * H[2, 2] - H[0, 2] * H[2, 0]
+    c12 = H[0, 1] * H[2, 0] - H[0, 0] * H[2, 1]
+    c20 = H[0, 1] * H[1, 2] - H[0, 2] * H[1, 1]
+    c21 = H[0, 2] * H[1, 0] - H[0, 0] * H[1, 2]
+    c22 = H[0, 0] * H[1, 1] - H[0, 1] * H[1, 0]
+    out[0] = (c00 * g[0] + c10 * g[1] + c20 * g[2]) / det
+    out[1] = (c01 * g[0] + c11 * g[1] + c21 * g[2]) / det
+    out[2] = (c02 * g[0] + c12 * g[1] + c22 * g[2]) / det
+    return out
 
 
 @njit(cache=True)
