@@ -99,7 +99,7 @@ def gauss_newton_step(x, y, qx, qy, f, R, w) -> np.ndarray:
 def solve3(H: np.ndarray, g: np.ndarray) -> np.ndarray:
     """H⁻¹ g for a 3×3 H by its adjugate, H⁻¹ = adj(H) / det(H); zero where |det H| <
     1e-30 (ill-posed). Written out rather than ``np.linalg.solve``, whose LAPACK binding
-    took 4.1 s of a fresh install's first compile (the kernels' 20 s), for a 3×3 system."""
+    took 4.1 s of a fresh install's first compile, then 20 s, for a 3×3 system."""
     c00 = H[1, 1] * H[2, 2] - H[1, 2] * H[2, 1]
     c01 = H[1, 2] * H[2, 0] - H[1, 0] * H[2, 2]
     c02 = H[1, 0] * H[2, 1] - H[1, 1] * H[2, 0]

@@ -302,7 +302,7 @@ def compiling_notice() -> tuple[str, ...]:
 
     if kernels_cached():
         return ()
-    return (f"{COMPILING}: about 20 s, once (cached in {cache_dir()})",)
+    return (f"{COMPILING}: about 15 s, once (cached in {cache_dir()})",)
 
 
 def dates_rows(settings: Settings, log: GyroLog | None = None, lens: Lens | None = None) -> bool:

@@ -120,7 +120,7 @@ def check_report_folder(folder: Path) -> None:
 
 def announce_compiling() -> None:
     """A one-line notice when the estimator's kernels are not compiled yet: the first
-    run spends about 20 s compiling them (cached for every later run)."""
+    run spends about 15 s compiling them (cached for every later run)."""
     from stabilize.pipeline import compiling_notice
 
     for line in compiling_notice():

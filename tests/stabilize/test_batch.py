@@ -140,7 +140,7 @@ def test_a_files_notices_leave_out_the_batchs_own(folder, tmp_path, monkeypatch)
     import stabilize.pipeline as pipeline
     from stabilize import Settings
 
-    said = f"{pipeline.COMPILING}: about 20 s, once"
+    said = f"{pipeline.COMPILING}: about 15 s, once"
     monkeypatch.setattr(pipeline, "compiling_notice", lambda: (said,))
     (job,) = find_jobs(folder, tmp_path / "out", "a.mp4")
     row = batch.run_job(job, Settings(), lambda n: None)
