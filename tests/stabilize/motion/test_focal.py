@@ -15,7 +15,13 @@ import stabilize.motion.focal as focal_module
 from rotation.focal import FocalEstimate
 from stabilize import Settings
 from stabilize.motion.estimate import estimate_rotations
-from stabilize.motion.focal import FULL_FRAME_DIAGONAL_MM, estimate_motion, initial_focal
+from stabilize.motion.focal import (
+    FULL_FRAME_DIAGONAL_MM,
+    FocalChoice,
+    _kept_note,
+    estimate_motion,
+    initial_focal,
+)
 from stabilize.video import ffmpeg_exe, probe
 from tests.stabilize.helpers import held_upright
 
@@ -36,6 +42,16 @@ def test_the_metadata_focal_length_is_read(shaky, tmp_path):
     assert choice.px == pytest.approx(26.0 * (320**2 + 180**2) ** 0.5 / FULL_FRAME_DIAGONAL_MM)
     assert initial_focal(Settings(fov=50.0), info, None).source == "given"
     assert initial_focal(Settings(), probe(shaky), None).source == "default"
+
+
+def test_a_focal_length_kept_is_said_with_the_option_that_gives_the_lens_own():
+    # 1920 px across at 69° (the default) and at 52° (a phone's metadata)
+    default = FocalChoice(960 / math.tan(math.radians(34.5)), 1920, "default")
+    said = _kept_note(default)
+    assert "the default's 69.0° (a phone's main camera) kept" in said
+    assert said.endswith("--fov gives the lens's own")
+    metadata = FocalChoice(960 / math.tan(math.radians(26.0)), 1920, "metadata")
+    assert "the metadata's 52.0° kept" in _kept_note(metadata)
 
 
 @pytest.fixture(scope="module")
