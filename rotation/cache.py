@@ -66,7 +66,28 @@ def use_plain_messages() -> None:
 
 
 def kernels_cached() -> bool:
-    """Whether the estimator's kernels have been compiled and cached before (else the
-    first estimate compiles them, which takes a while)."""
-    folder = cache_dir()
-    return folder.is_dir() and any(folder.rglob(KERNEL_INDEX))
+    """Whether this install's estimator kernels are cached, compiled from its sources as
+    they are (else the first estimate compiles them, which takes a while).
+
+    numba keeps a source folder's kernels in a subfolder of the cache of its own, named
+    after the folder and the SHA-1 of its path (``_CacheLocator.get_suitable_cache_subpath``),
+    and compiles again where the source is newer than what it cached. Any index anywhere
+    in the cache used to count: a second checkout or virtual environment on a machine
+    that had run another compiled for 16 s without the notice."""
+    source = Path(os.path.abspath(__file__)).with_name("hough.py")
+    folder = cache_dir() / cache_subfolder(source.parent)
+    built = source.stat().st_mtime
+    return folder.is_dir() and any(i.stat().st_mtime >= built for i in folder.glob(KERNEL_INDEX))
+
+
+def cache_subfolder(sources: Path) -> str:
+    """The subfolder of the cache numba keeps the kernels of the folder ``sources`` in:
+    its name and the SHA-1 of its absolute path, as numba names it.
+
+    >>> cache_subfolder(Path("/opt/rotation"))
+    'rotation_8ca058647ea3af216d14fed72e80dc62099aa363'
+    """
+    import hashlib
+
+    path = os.path.abspath(sources)
+    return f"{os.path.basename(path)}_{hashlib.sha1(path.encode()).hexdigest()}"

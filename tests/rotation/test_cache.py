@@ -55,3 +55,29 @@ def test_numba_formats_its_messages_without_rebinding_the_standard_streams():
     if out.stderr.strip() == "no colorama":
         pytest.skip("colorama is not installed: numba colours nothing")
     assert out.stdout.strip() == "0", out.stderr
+
+
+def test_the_kernels_count_as_cached_only_where_this_install_compiled_them(monkeypatch, tmp_path):
+    # a second checkout compiled for 16 s without the notice: another install's index
+    # anywhere in the cache counted
+    import numba.core.caching
+
+    from rotation.cache import KERNEL_INDEX, cache_subfolder, kernels_cached
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    sources = Path(os.path.abspath(rotation.__file__)).parent
+    index = KERNEL_INDEX.replace("*", "337.py311")
+    # numba's own name for the folder it keeps these sources' kernels in
+    named = numba.core.caching._CacheLocator.get_suitable_cache_subpath(str(sources / "hough.py"))
+    assert cache_subfolder(sources) == named
+    other = tmp_path / cache_subfolder(tmp_path / "another-checkout" / "rotation")
+    other.mkdir()
+    (other / index).write_bytes(b"")
+    assert not kernels_cached()
+    own = tmp_path / named
+    own.mkdir()
+    (own / index).write_bytes(b"")
+    assert kernels_cached()
+    stale = (sources / "hough.py").stat().st_mtime - 60  # compiled before the source changed
+    os.utime(own / index, (stale, stale))
+    assert not kernels_cached()
