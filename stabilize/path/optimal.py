@@ -429,12 +429,6 @@ def high_passed_velocity(n: int, sigma: float) -> NDArray[np.float64]:
     return B
 
 
-def shake_operator(n: int, k: int, sigma: float) -> sparse.csr_array:
-    """(I - G_σ) Δ ⊗ I_k: the high-passed velocity of a path of n frames and k
-    components, flattened frame-major (:func:`high_passed_velocity`)."""
-    return sparse.kron(high_passed_velocity(n, sigma), sparse.eye_array(k)).tocsr()
-
-
 def _shake_cost(
     p0: NDArray, sigma: float, hold: float = HOLD
 ) -> tuple[sparse.csc_array, NDArray] | None:
@@ -446,9 +440,10 @@ def _shake_cost(
     is about 1e-7, where Clarabel's absolute tolerances (1e-8) end the solve early: on
     karma 0.03–0.1% above the optimum, the path up to 0.4 px off it. P is given as its
     upper triangle, the form Clarabel takes, made once for every solve of the window.
-    With H = B ⊗ I_k (:func:`shake_operator`), HᵀH = BᵀB ⊗ I_k: the components do not
-    meet in the cost, so BᵀB is made dense, n × n, and spread over them. The sparse
-    product HᵀH took 0.40 s a window of 300 frames and 7 components (240 fps), this 0.04.
+    With H = B ⊗ I_k, the operator on the path's n × k values flattened frame-major,
+    HᵀH = BᵀB ⊗ I_k: the components do not meet in the cost, so BᵀB is made dense,
+    n × n, and spread over them. The sparse product HᵀH took 0.40 s a window of 300
+    frames and 7 components (240 fps), this 0.04.
     """
     n, k = p0.shape
     if n < 3:

@@ -9,8 +9,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 from numpy.typing import NDArray
+from scipy import sparse
 
 from rotation import so3
+from stabilize.path.optimal import high_passed_velocity
 from stabilize.video import ffmpeg_exe
 from stabilize.warp.coverage import Framing
 from stabilize.warp.lens import Lens
@@ -123,3 +125,10 @@ def shaky_path(n=120, seed=0, shake_deg=1.0, pan_deg_s=0.0):
     angles[:, 1] += np.radians(pan_deg_s) * t
     O = so3.exp_so3(-angles)  # world → camera
     return t, O
+
+
+def shake_operator(n: int, k: int, sigma: float) -> sparse.csr_array:
+    """(I - G_σ) Δ ⊗ I_k: the high-passed velocity of a path of n frames and k
+    components, flattened frame-major (:func:`high_passed_velocity` for each): the
+    operator whose HᵀH the path programme's cost makes from its n × n core."""
+    return sparse.kron(high_passed_velocity(n, sigma), sparse.eye_array(k)).tocsr()

@@ -17,7 +17,6 @@ from stabilize.path.optimal import (
     conformal_split,
     hold_at,
     optimal_path,
-    shake_operator,
     unrolled,
     windows,
 )
@@ -25,7 +24,7 @@ from stabilize.path.plan import plan_path
 from stabilize.path.smoothing import smooth_orientations
 from stabilize.settings import Settings
 from stabilize.warp.coverage import CORNERS, Framing
-from tests.stabilize.helpers import shaky_path
+from tests.stabilize.helpers import shake_operator, shaky_path
 
 K = intrinsics(500.0, (360, 640))
 SIZE = (360, 640)
