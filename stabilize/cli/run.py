@@ -163,7 +163,8 @@ def run(
     elif not quiet:
         typer.echo(
             # the work's speed, in words a clip's frame rate is not read for ("46.9 fps")
-            f"{output_path}: {summary['frames']} frames, zoom {summary['zoom']:.3f}, "
+            f"{output_path}: {summary['frames']} frames, zoom {summary['zoom']:.3f} "
+            f"(cropping ratio {summary['cropping_ratio']:.3f}), "
             f"in {summary['seconds']['total']:.1f} s ({summary['fps']:.1f} frames a second)",
             err=True,
         )

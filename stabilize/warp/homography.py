@@ -33,3 +33,28 @@ def inverses(H: NDArray) -> NDArray[np.float64]:
     """Inverse homographies, scaled to H[2, 2] = 1 so that they interpolate."""
     Hinv = np.linalg.inv(H)
     return Hinv / Hinv[..., 2:, 2:]
+
+
+def cropping_ratio(H: NDArray, size: tuple[int, int]) -> NDArray[np.float64]:
+    """The cropping ratio of each frame (N,) warped by H (N, 3, 3), input → output pixels,
+    at an output of ``size`` (H, W): the scale √|det J| of the inverse map at the
+    output's middle c, where for H⁻¹ = [[A, t], [bᵀ, s]] and its image x of c
+
+        J = (A − x bᵀ) / (bᵀc + s),
+
+    the share of the input's width the output shows there. It is what an evaluation of
+    the output against its input reads as cropping (1: nothing cropped; 1/z for a zoom
+    z), where the frame's own zoom (max_zoom's) leaves out a 2-D correction's.
+
+    >>> import numpy as np
+    >>> zoom = np.array([[[1.25, 0, -80.0], [0, 1.25, -45.0], [0, 0, 1]]])
+    >>> cropping_ratio(zoom, (360, 640)).round(6).tolist()
+    [0.8]
+    """
+    Hinv = np.linalg.inv(np.asarray(H, np.float64))
+    h, w = size
+    c = np.array([(w - 1) / 2, (h - 1) / 2, 1.0])
+    u = Hinv @ c
+    x = u[..., :2] / u[..., 2:]
+    J = (Hinv[..., :2, :2] - x[..., :, None] * Hinv[..., 2, None, :2]) / u[..., 2, None, None]
+    return np.sqrt(np.abs(np.linalg.det(J)))
