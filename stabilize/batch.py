@@ -185,6 +185,7 @@ def write_manifest(out_dir: Path, rows: dict[str, dict]) -> None:
         "error",
         "mean_support",
         "zoom",
+        "cropping_ratio",
         "frames",
         "peak_mb",
         "notices",
@@ -321,6 +322,7 @@ def run_job(job: Job, settings, on_frames: Callable[[int], None] | None = None) 
             error="",
             frames=summary["frames"],
             zoom=summary["zoom"],
+            cropping_ratio=summary["cropping_ratio"],
             mean_support=summary["mean_support"],
         )
     except Exception as err:  # isolate every failure: one bad file must not stop the rest

@@ -59,6 +59,7 @@ def test_a_folder_with_bad_files(folder, tmp_path):
     rows = {r["input"]: r for r in json.loads((out / "manifest.json").read_text())}
     assert [rows[k]["status"] for k in sorted(rows)] == ["done", "failed", "done", "failed"]
     assert rows["corrupt.mp4"]["error"] and rows["notes.mov"]["error"]
+    assert 1 / rows["a.mp4"]["zoom"] <= rows["a.mp4"]["cropping_ratio"] < 1  # as the run's
     assert (out / "manifest.csv").read_text().count("\n") == 5
     assert {p: digest(p) for p in before} == before  # every input untouched
 
