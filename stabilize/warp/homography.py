@@ -37,14 +37,14 @@ def inverses(H: NDArray) -> NDArray[np.float64]:
 
 def cropping_ratio(H: NDArray, size: tuple[int, int]) -> NDArray[np.float64]:
     """The cropping ratio of each frame (N,) warped by H (N, 3, 3), input → output pixels,
-    at an output of ``size`` (H, W): the scale √|det J| of the inverse map at the
-    output's middle c, where for H⁻¹ = [[A, t], [bᵀ, s]] and its image x of c
+    at an output of ``size`` (height, width): the scale √|det J| of the inverse map at
+    the output's middle c, where for H⁻¹ = [[A, t], [bᵀ, s]] and its image x of c
 
         J = (A − x bᵀ) / (bᵀc + s),
 
     the share of the input's width the output shows there. It is what an evaluation of
     the output against its input reads as cropping (1: nothing cropped; 1/z for a zoom
-    z), where the frame's own zoom (max_zoom's) leaves out a 2-D correction's.
+    z). Unlike the zoom the crop mode chose, it counts a 2-D correction's zoom-outs.
 
     >>> import numpy as np
     >>> zoom = np.array([[[1.25, 0, -80.0], [0, 1.25, -45.0], [0, 0, 1]]])
