@@ -43,7 +43,7 @@ def stage_bars(*, quiet: bool = False) -> Iterator[Callable[..., Callable[[int],
     One live display holds every stage's bar: each stage's own display, on a console of
     its own, drew over the last one's line, so a terminal's bar flickered between
     "estimating" and "stabilising", and a log held them in reverse order. The bars stay
-    when the job ends; a failure clears them, leaving no half bar above its message."""
+    when the job ends; a failure clears them, leaving nothing above its message."""
     if quiet:
         yield lambda label, total, unit="frames": lambda n=1: None
         return
@@ -64,6 +64,9 @@ def stage_bars(*, quiet: bool = False) -> Iterator[Callable[..., Callable[[int],
             yield bar
         except BaseException:
             progress.live.transient = True
+            # rich ends a display on a log or a pipe with an empty line, which stood above
+            # the error line of a clip found missing while the bars stood ready
+            progress.console.quiet = not progress.console.is_interactive
             raise
 
 
