@@ -279,7 +279,7 @@ def main() -> None:
         found = None
         if args.equal_crop:
             default = AtCrop(Settings().max_zoom, ours_m, t_ours, mine)
-            found = at_crop(cmd, clip, fps, default, theirs_m.cropping_ratio)
+            found = at_crop(cmd, clip, info.size, fps, default, theirs_m.cropping_ratio)
             print(_row(name, f"ours {found.max_zoom:.3f}", found.metrics, found.seconds))
             equal_ratios.append(found.metrics.residual_shake_px / theirs_m.residual_shake_px)
         if args.spread:
@@ -433,8 +433,10 @@ class AtCrop:
     path: Path
 
 
-def at_crop(cmd: list[str], clip: Path, fps: float, ours: AtCrop, crop: float) -> AtCrop:
-    """Our run of ``clip`` (``cmd``; ``ours``: at the default budget, its output)
+def at_crop(
+    cmd: list[str], clip: Path, size: tuple[int, int], fps: float, ours: AtCrop, crop: float
+) -> AtCrop:
+    """Our run of ``clip`` (frames of ``size``; ``cmd``; ``ours``: at the default budget)
     again with ``--max-zoom`` scaled until its cropping ratio lies within ``CROP_MATCH``
     of ``crop`` (vid.stab's), at most ``CROP_TRIES`` runs, the nearest kept: the issue's
     comparison at equal crop. Our mean crop is lighter than the budget's 1/max-zoom where
@@ -452,7 +454,6 @@ def at_crop(cmd: list[str], clip: Path, fps: float, ours: AtCrop, crop: float) -
             break
         max_zoom = last.max_zoom * last.metrics.cropping_ratio / crop
         seconds, _ = timed([*run, "--max-zoom", f"{max_zoom:.4f}"])
-        size = probe(clip).size
         _, metrics = evaluate_pair(read_frames(clip), read_frames(out, size), fps)
         tried.append(AtCrop(max_zoom, metrics, seconds, out))
         if abs(metrics.cropping_ratio - last.metrics.cropping_ratio) < CROP_STILL:
