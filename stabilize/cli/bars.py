@@ -60,14 +60,21 @@ def stage_bars(*, quiet: bool = False) -> Iterator[Callable[..., Callable[[int],
 
             return advance
 
-        try:
+        with _cleared_on_failure(progress):
             yield bar
-        except BaseException:
-            progress.live.transient = True
-            # rich ends a display on a log or a pipe with an empty line, which stood above
-            # the error line of a clip found missing while the bars stood ready
-            progress.console.quiet = not progress.console.is_interactive
-            raise
+
+
+@contextlib.contextmanager
+def _cleared_on_failure(progress: Progress) -> Iterator[None]:
+    """A failure inside clears ``progress``' bars, leaving nothing above its message."""
+    try:
+        yield
+    except BaseException:
+        progress.live.transient = True
+        # rich ends a display on a log or a pipe with an empty line, which stood above
+        # the error line of a clip found missing while the bars stood ready
+        progress.console.quiet = not progress.console.is_interactive
+        raise
 
 
 @contextlib.contextmanager
@@ -116,4 +123,5 @@ def batch_progress(
             rate = count[0] / max(time.perf_counter() - start, 1e-6)
             progress.update(task, frames=count[0], rate=f" ({rate:.1f}/s)")
 
-        yield file_done, frames_done
+        with _cleared_on_failure(progress):  # the files done stay, listed above it
+            yield file_done, frames_done

@@ -2,7 +2,7 @@
 
 import pytest
 
-from stabilize.cli.bars import progress_bar, with_bars
+from stabilize.cli.bars import batch_progress, progress_bar, with_bars
 
 
 def two_stages(bar) -> str:
@@ -45,3 +45,21 @@ def test_a_single_bar_counts_its_units(capsys):
         advance(4)
     (line,) = capsys.readouterr().err.splitlines()
     assert line.split()[0] == "rendering" and "4/4" in line
+
+
+def test_a_failed_batch_leaves_no_bar_above_its_message(capsys):
+    # a Ray cluster lost mid-batch: its files bar ended with an empty line above the error
+    with pytest.raises(ConnectionError, match="lost"):
+        with batch_progress(3) as (file_done, frames_done):
+            frames_done(10)
+            file_done()
+            raise ConnectionError("lost")
+    assert capsys.readouterr().err == ""
+
+
+def test_a_batch_bar_counts_files_and_frames(capsys):
+    with batch_progress(2) as (file_done, frames_done):
+        frames_done(30)
+        file_done()
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.split()[0] == "files" and "1/2" in line and "30 frames" in line
