@@ -295,26 +295,19 @@ def main() -> None:
                 )
                 print(f"{'':28s}{'mirrored':10s}ours at vid.stab's crop {span(found_all)}")
                 equal_mean_ratios.append(np.mean(found_all) / np.mean(theirs_all))
-    print(
-        f"\nours ÷ vid.stab residual shake: median {statistics.median(ratios):.2f} "
-        f"({', '.join(f'{r:.2f}' for r in ratios)}); outputs and their shake plots in {work}"
-    )
-    if equal_ratios:
-        print(
-            f"the same, ours at vid.stab's crop: median {statistics.median(equal_ratios):.2f} "
-            f"({', '.join(f'{r:.2f}' for r in equal_ratios)})"
-        )
-    if mean_ratios:
-        print(
-            f"the same, of the four readings' means: median {statistics.median(mean_ratios):.2f} "
-            f"({', '.join(f'{r:.2f}' for r in mean_ratios)})"
-        )
-    if equal_mean_ratios:
-        print(
-            "the same, of the four readings' means, ours at vid.stab's crop: median "
-            f"{statistics.median(equal_mean_ratios):.2f} "
-            f"({', '.join(f'{r:.2f}' for r in equal_mean_ratios)})"
-        )
+    print(f"\nours ÷ vid.stab residual shake: {medians(ratios)}; outputs and shake plots in {work}")
+    for label, found_ratios in (
+        ("ours at vid.stab's crop", equal_ratios),
+        ("of the four readings' means", mean_ratios),
+        ("of the four readings' means, ours at vid.stab's crop", equal_mean_ratios),
+    ):
+        if found_ratios:
+            print(f"the same, {label}: {medians(found_ratios)}")
+
+
+def medians(ratios: list[float]) -> str:
+    """The ratios' median, and each of them."""
+    return f"median {statistics.median(ratios):.2f} ({', '.join(f'{r:.2f}' for r in ratios)})"
 
 
 @dataclass(frozen=True)
@@ -447,11 +440,11 @@ def at_crop(
     lighter crop its path needs."""
     tried = [ours]
     for k in range(CROP_TRIES):
-        out = ours.path.with_name(f"{ours.path.stem}_at_crop{k}{ours.path.suffix}")
-        run = [str(out) if part == str(ours.path) else part for part in cmd]
         last = tried[-1]
         if abs(last.metrics.cropping_ratio - crop) <= CROP_MATCH:
             break
+        out = ours.path.with_name(f"{ours.path.stem}_at_crop{k}{ours.path.suffix}")
+        run = [str(out) if part == str(ours.path) else part for part in cmd]
         max_zoom = last.max_zoom * last.metrics.cropping_ratio / crop
         seconds, _ = timed([*run, "--max-zoom", f"{max_zoom:.4f}"])
         _, metrics = evaluate_pair(read_frames(clip), read_frames(out, size), fps)
