@@ -21,6 +21,10 @@ residual shake of :mod:`stabilize.evaluate.shake`), and η = ``HOLD`` keeps the 
 near the target where nothing else decides. A pan is followed because the crop holds
 the path within the budget of the raw one.
 
+Where the target breaks the budget in most of a window's frames, the norms weigh the
+components by how they move the image (:func:`image_metric`): a turn and a 2-D shift
+that move the frame alike are one shake there, as the residual shake reads them.
+
 The crop constraint is linearised around the current δ (a finite-difference Jacobian of
 :meth:`stabilize.warp.coverage.Framing.border_sources`, so that lenses and rolling
 shutters are handled as the warp handles them), and the programme solved again around
@@ -48,6 +52,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from functools import partial
+from itertools import product
 
 import numpy as np
 from numpy.typing import NDArray
@@ -64,6 +69,20 @@ from stabilize.path.budget import Trajectory
 # vid.stab 0.61, 0.99, 6.86, 3.05). Adding the high-passed velocity to the L1 programme
 # as a fifth term helped the GoPro clips and made the 45° walk worse (3.12–3.24).
 HOLD = 1e-4
+# A window is planned by the image's motion (:func:`image_metric`) where the target breaks
+# the budget in at least this share of its frames: violent shake, where the trade between
+# the components decides what is left. The rendered 3° and 4° clips of
+# bench/path_bench.py break it in 0.55 and 0.77 of their frames, and read 7.98 and 12.51
+# px so, against 8.91 and 14.77 (vid.stab 8.62 and 13.13); the real clips of the bench
+# break it in at most 0.28 (cockatoo) and plan as before: planned so in every window (the
+# 2-D path summed about each frame's middle) they read no steadier (lossless mirrored
+# means on 24 views, geometric mean 1.016).
+BINDING = 0.5
+# In the image's metric, each component's own shake at this share: without it a turn
+# undone by an opposite shift costs nothing. Measured with the 2-D path summed about each
+# frame's middle: at 0.1 the 3° clip's programme found no answer (bent: 14.11 px), at 0.3
+# the 3° and 4° clips read 8.03 and 12.41, at 1.0 8.40 and 13.73
+OWN = 0.3
 HOLD_FPS = 30.0  # the frame rate HOLD was measured at (:func:`hold_at`)
 ROUNDS = 6  # linearise, solve, check
 STEP = 1e-4  # finite-difference step of the Jacobian (rad, normalised units)
@@ -137,6 +156,7 @@ def optimal_path(
     floor: float = 0.0,
     settled: Callable[[int], None] = lambda frames: None,
     hold: float = HOLD,
+    image: NDArray | None = None,
 ) -> Trajectory | None:
     """The steadiest path in the sense above whose every frame covers the output; None
     where the programme fails (the caller falls back). ``corners``: the indices, among
@@ -144,7 +164,9 @@ def optimal_path(
     upper bounds on δ (+inf for none); ``sigma``: the low-pass's σ, in frames;
     ``middle``, ``floor``: each frame's σ_min/σ_max at the output's middle is held at
     least ``floor`` (none for 0 or without ``middle``); ``settled`` hears how many
-    frames are planned so far, after each window; ``hold``: η (:func:`hold_at`)."""
+    frames are planned so far, after each window; ``hold``: η (:func:`hold_at`);
+    ``image``: the components' weights by the image's motion (:func:`image_metric`), for
+    the windows whose target breaks the budget in at least ``BINDING`` of their frames."""
     n = len(target.turn)
     k = 3 + len(parts)
     delta = np.zeros((n, k))
@@ -159,8 +181,11 @@ def optimal_path(
         fixed = FIXED if start > 0 else 0
         frames = np.arange(start, stop)
         window = (target, sources, size, parts, corners, frames, delta, fixed)
-        for bound in bounds:
-            found = _solve_window(*window, ceiling[frames], sigma, hold, bound)
+        binds = image is not None and _binds(target, sources, size, frames)
+        # where the image's metric finds no answer, the components alike (6° of shake
+        # at f = 300 px across 640: bent by the image's, planned alike)
+        for metric, bound in product([image, None] if binds else [None], bounds):
+            found = _solve_window(*window, ceiling[frames], sigma, hold, bound, metric=metric)
             if found is not None:
                 break
         if found is None:
@@ -171,7 +196,9 @@ def optimal_path(
             begun = delta.copy()
             begun[frames] = found
             again = (target, sources, size, parts, corners, frames, begun, fixed)
-            kept = _solve_window(*again, ceiling[frames], sigma, hold, bounds[0], from_start=True)
+            kept = _solve_window(
+                *again, ceiling[frames], sigma, hold, bounds[0], from_start=True, metric=metric
+            )
             found = found if kept is None else kept
         keep = stop if stop == n else stop - overlap + FIXED
         delta[start + fixed : keep] = found[fixed : keep - start]
@@ -191,6 +218,44 @@ def hold_at(interval: float) -> float:
     bent start: a steady pan, known exactly, came out 0.41 px a thirtieth of a second
     shaky (windows of 10σ), 0.28 with η so (0.18 at 30 fps)."""
     return HOLD * min(1.0, HOLD_FPS * interval) ** 2
+
+
+def image_metric(parts: tuple[int, ...], focal: float, width: int) -> NDArray[np.float64]:
+    """G (k, k): the weights of the path's components (the turn's increments ω in the
+    camera's axes, then the 2-D path's ``parts``) by the image's motion, in units of f.
+
+    A turn ω moves the frame's middle by f·(ω_y, -ω_x) and turns it by ω_z, which moves
+    its side by (w/2)·ω_z; the 2-D step moves it by f·(t_x, t_y), turns it by θ and
+    zooms it by ln s. The residual shake's parts (:mod:`stabilize.evaluate.shake`) are
+    those sums, so with r = (w/2)/f
+
+        x = ω_y + t_x,   y = -ω_x + t_y,   roll = r (ω_z + θ),   zoom = r ln s,
+
+    and G = CᵀC + ``OWN``·W², C the map to (x, y, roll, zoom), W each component's own
+    (1, or r for a roll, an angle or a zoom). Equal weights (the identity) see a turn
+    and a shift that move the frame together as two smaller shakes. The 2-D steps are
+    the chained path's (:mod:`stabilize.path.residual`), the image's to first order."""
+    r = width / 2.0 / focal
+    C = np.array(
+        [
+            [0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, r, 0.0, 0.0, r, 0.0],
+            [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, r],
+        ]
+    )
+    own = np.array([1.0, 1.0, r, 1.0, 1.0, r, r])
+    columns = [0, 1, 2, *(3 + part for part in parts)]
+    C, own = C[:, columns], own[columns]
+    return C.T @ C + OWN * np.diag(own * own)
+
+
+def _binds(target: Trajectory, sources: Sources, size: tuple[int, int], frames: NDArray) -> bool:
+    """Whether the target breaks the budget in at least ``BINDING`` of ``frames``."""
+    h, w = size
+    lo, hi = np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5])
+    out = _outside(sources(target.take(frames), frames), lo, hi).any(axis=1)
+    return bool(out.mean() >= BINDING)
 
 
 def windows(sigma: float) -> tuple[int, int]:
@@ -222,10 +287,12 @@ def _solve_window(
     hold: float,
     stretch: tuple[Middle | None, float],
     from_start: bool = False,
+    metric: NDArray | None = None,
 ) -> NDArray | None:
     """δ (n, k) for one window of ``frames``, its first ``fixed`` rows held, at most
     ``ceiling``, within the ``stretch`` (middle, floor) of :func:`optimal_path`; started
-    from the target, or with ``from_start`` from ``delta``."""
+    from the target, or with ``from_start`` from ``delta``; ``metric``: the components'
+    weights (:func:`image_metric`; alike without)."""
     part = target.take(frames)
     x = delta[frames].copy()
     if not from_start:
@@ -237,7 +304,7 @@ def _solve_window(
     active = np.zeros(src.shape[:2], bool)
     active[fixed:, corners] = True  # the held frames were checked in the last window
     margin = np.full(len(frames), MARGIN_PX)
-    cost = _shake_cost(unrolled(part, parts), sigma, hold)  # the same in every round
+    cost = _shake_cost(unrolled(part, parts), sigma, hold, metric)  # the same every round
     middle, floor = stretch
     bounded = middle is not None and floor > 0
     tight = np.ones(len(frames))  # the stretch bound's share, where the linearisation was off
@@ -430,7 +497,7 @@ def high_passed_velocity(n: int, sigma: float) -> NDArray[np.float64]:
 
 
 def _shake_cost(
-    p0: NDArray, sigma: float, hold: float = HOLD
+    p0: NDArray, sigma: float, hold: float = HOLD, metric: NDArray | None = None
 ) -> tuple[sparse.csc_array, NDArray] | None:
     """(P, q) of the objective ½ δᵀP δ + qᵀδ = (½ ‖(I - G_σ) Δ(p0 + δ)‖² + ½ η ‖δ‖²) / c₀
     + const for the target's unrolled path p0 (n, k); None for fewer than 3 frames.
@@ -443,13 +510,20 @@ def _shake_cost(
     With H = B ⊗ I_k, the operator on the path's n × k values flattened frame-major,
     HᵀH = BᵀB ⊗ I_k: the components do not meet in the cost, so BᵀB is made dense,
     n × n, and spread over them. The sparse product HᵀH took 0.40 s a window of 300
-    frames and 7 components (240 fps), this 0.04.
+    frames and 7 components (240 fps), this 0.04. With a ``metric`` G (k, k), the norms
+    are ‖·‖_G (:func:`image_metric`): HᵀH = BᵀB ⊗ G.
     """
     n, k = p0.shape
     if n < 3:
         return None
     B = high_passed_velocity(n, sigma)
     shake = B @ p0  # (n - 1, k)
+    if metric is not None:
+        weighed = shake @ metric
+        unit = max(0.5 * float(np.sum(weighed * shake)), STILL * n * k)
+        M = sparse.csr_array(B.T @ B + hold * np.eye(n))
+        P = sparse.triu(sparse.kron(M, sparse.csr_array(metric))) / unit
+        return sparse.csc_array(P), (B.T @ weighed).ravel() / unit
     unit = max(0.5 * float(np.sum(shake * shake)), STILL * n * k)
     M = np.triu(B.T @ B + hold * np.eye(n)) / unit
     P = sparse.kron(sparse.csr_array(M), sparse.eye_array(k))

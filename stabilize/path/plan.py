@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from stabilize.motion.cuts import shots
 from stabilize.path import residual as planar
 from stabilize.path.budget import Trajectory, respect_zoom_budget
-from stabilize.path.optimal import hold_at, optimal_path
+from stabilize.path.optimal import hold_at, image_metric, optimal_path
 from stabilize.path.smoothing import orientations_from_rotations, smooth_orientations
 from stabilize.path.zoom import CROP_MODES, choose_zoom
 from stabilize.progress import Progress, no_progress
@@ -144,8 +144,20 @@ def plan_path(
         ceiling, sigma = _ceiling(raw, target, parts), settings.smooth / frame_interval(times)
         floor = 1 - settings.max_stretch / 100
         hold = hold_at(frame_interval(times))
+        image = image_metric(parts, float(K[0, 0]), size[1])
         return optimal_path(
-            target, sources, size, parts, CORNERS, ceiling, sigma, middle, floor, settled, hold
+            target,
+            sources,
+            size,
+            parts,
+            CORNERS,
+            ceiling,
+            sigma,
+            middle,
+            floor,
+            settled,
+            hold,
+            image,
         )
 
     path = planned(settings.smooth)

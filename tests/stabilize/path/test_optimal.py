@@ -11,11 +11,13 @@ from stabilize.path.budget import Trajectory, respect_zoom_budget
 from stabilize.path.optimal import (
     HOLD,
     NEAR,
+    OWN,
     TRUST,
     _programme,
     _shake_cost,
     conformal_split,
     hold_at,
+    image_metric,
     optimal_path,
     unrolled,
     windows,
@@ -222,9 +224,9 @@ def test_a_window_solved_without_the_stretch_bound_is_bounded_from_there(monkeyp
     n = len(t)
     solve, calls = optimal._solve_window, []
 
-    def bounded_fails_first(*args, from_start=False):
+    def bounded_fails_first(*args, from_start=False, metric=None):
         calls.append((args[-1][1], from_start))
-        return None if len(calls) == 1 else solve(*args, from_start=from_start)
+        return None if len(calls) == 1 else solve(*args, from_start=from_start, metric=metric)
 
     monkeypatch.setattr(optimal, "_solve_window", bounded_fails_first)
     settings = Settings(motion="translation")
@@ -294,3 +296,55 @@ def test_windows_see_what_the_smoothing_sees():
 def test_the_hold_weighs_a_second_as_at_30_fps():
     assert hold_at(1 / 30) == HOLD and hold_at(1 / 20) == HOLD
     assert hold_at(1 / 240) == pytest.approx(HOLD / 64)
+
+
+def test_the_image_metric_weighs_a_turn_and_a_shift_by_how_they_move_the_frame():
+    # f = 500 px, w = 640: a roll moves the side by r = 320/500 of what a pitch moves it.
+    r = 320 / 500
+    G = image_metric((0, 1, 2, 3), 500.0, 640)
+    eps = 1e-3
+    together = np.array([0, eps, 0, eps, 0, 0, 0])  # a yaw and a shift both move x by +2ε
+    undone = np.array([0, eps, 0, -eps, 0, 0, 0])  # the shift undoes the yaw: x still
+    assert together @ G @ together == pytest.approx((4 + 2 * OWN) * eps**2)
+    assert undone @ G @ undone == pytest.approx(2 * OWN * eps**2)
+    pitch_and_y = np.array([-eps, 0, 0, 0, eps, 0, 0])  # y = -ω_x + t_y
+    assert pitch_and_y @ G @ pitch_and_y == pytest.approx((4 + 2 * OWN) * eps**2)
+    roll = np.array([0, 0, eps, 0, 0, eps, 0])  # the turn's roll and the 2-D angle add
+    assert roll @ G @ roll == pytest.approx((4 + 2 * OWN) * (r * eps) ** 2)
+    # the turn alone: each axis as far as it moves the frame
+    assert np.allclose(image_metric((), 500.0, 640), np.diag([1, 1, r * r]) * (1 + OWN))
+
+
+def test_a_window_the_budget_binds_in_is_planned_by_the_images_motion():
+    # Violent shake against a tight budget, and a 2-D path whose shift follows the turn
+    # (the frame moves by both): planned by the image's metric, the path keeps less of
+    # the shake as the image moves it than planned with the components alike, and more
+    # as the components alike count it; each is the steadier by its own measure.
+    t, O = shaky_path(n=120, shake_deg=3.0, seed=11)
+    framing = Framing(K, SIZE)
+    max_zoom = 1.1
+    steps = so3.log_so3(_rotations(O))
+    q = np.zeros((len(O), 4))
+    q[1:, 0] = np.cumsum(0.5 * steps[:, 1])  # shifts with half the yaw's steps
+    S = smooth_orientations(O, t, 0.5)
+    qs = np.c_[np.convolve(q[:, 0], np.ones(15) / 15, "same"), np.zeros((len(O), 3))]
+    target = Trajectory(S, qs)
+
+    def sources(part, frames):
+        D = np.tile(np.eye(3), (len(frames), 1, 1))
+        D[:, 0, 2] = part.shift[:, 0] - q[frames, 0]
+        C = D @ part.turn @ np.swapaxes(O[frames], -1, -2)
+        return framing.border_sources(C, np.full(len(frames), max_zoom))
+
+    G = image_metric((0,), 500.0, 640)
+    alike = optimal_path(target, sources, SIZE, (0,), CORNERS)
+    by_image = optimal_path(target, sources, SIZE, (0,), CORNERS, image=G)
+    assert alike is not None and by_image is not None
+    H = shake_operator(len(O), 4, 15.0)
+
+    def shake(path, metric):
+        v = (H @ unrolled(path, (0,)).ravel()).reshape(-1, 4)
+        return float(np.einsum("ij,jk,ik->", v, metric, v))
+
+    assert shake(by_image, G) < shake(alike, G)
+    assert shake(alike, np.eye(4)) < shake(by_image, np.eye(4))
