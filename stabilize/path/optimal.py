@@ -72,7 +72,7 @@ HOLD = 1e-4
 # A window is planned by the image's motion (:func:`image_metric`) where the target breaks
 # the budget in at least this share of its frames: violent shake, where the trade between
 # the components decides what is left. The rendered 3° and 4° clips of
-# bench/path_bench.py break it in 0.55 and 0.77 of their frames, and read 7.98 and 12.51
+# bench/path_bench.py break it in 0.55 and 0.77 of their frames, and read 7.99 and 12.55
 # px so, against 8.91 and 14.77 (vid.stab 8.62 and 13.13); the real clips of the bench
 # break it in at most 0.28 (cockatoo) and plan as before: planned so in every window (the
 # 2-D path summed about each frame's middle) they read no steadier (lossless mirrored
