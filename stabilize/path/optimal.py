@@ -252,9 +252,7 @@ def image_metric(parts: tuple[int, ...], focal: float, width: int) -> NDArray[np
 
 def _binds(target: Trajectory, sources: Sources, size: tuple[int, int], frames: NDArray) -> bool:
     """Whether the target breaks the budget in at least ``BINDING`` of ``frames``."""
-    h, w = size
-    lo, hi = np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5])
-    out = _outside(sources(target.take(frames), frames), lo, hi).any(axis=1)
+    out = _outside(sources(target.take(frames), frames), *_input_box(size)).any(axis=1)
     return bool(out.mean() >= BINDING)
 
 
@@ -297,8 +295,7 @@ def _solve_window(
     x = delta[frames].copy()
     if not from_start:
         x[fixed:] = 0.0
-    h, w = size
-    lo, hi = np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5])
+    lo, hi = _input_box(size)
     check = partial(_checked, sources, part, frames, parts, lo, hi, fixed)
     src, out = check(x)  # (n, M, 2) at δ = x
     active = np.zeros(src.shape[:2], bool)
@@ -380,6 +377,12 @@ def _checked(
     out = _outside(src, lo, hi)
     out[:fixed] = False
     return src, out
+
+
+def _input_box(size: tuple[int, int]) -> tuple[NDArray, NDArray]:
+    """(lo, hi): the input's extent (x, y) in pixels, its edge pixels' centres inside."""
+    h, w = size
+    return np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5])
 
 
 def _outside(src: NDArray, lo: NDArray, hi: NDArray) -> NDArray[np.bool_]:

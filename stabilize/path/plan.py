@@ -129,9 +129,11 @@ def plan_path(
         zoom = np.full(len(frames), settings.max_zoom)
         return ~framing.covered(corrections(part, frames), zoom)
 
-    def steadiest(target: Trajectory, zoom: NDArray) -> Trajectory | None:
+    def steadiest(target: Trajectory, zoom: NDArray, over_budget: bool) -> Trajectory | None:
         """The steadiest path near ``target`` whose every frame covers the output at
-        its ``zoom`` (:func:`optimal_path`), or None where the programme fails."""
+        its ``zoom`` (:func:`optimal_path`), or None where the programme fails. Only a
+        target ``over_budget`` can break it in a window's frames, so only its windows
+        are looked at for the image's metric (a target within its zoom covers them all)."""
 
         def sources(part: Trajectory, frames: NDArray) -> NDArray:
             return framing.border_sources(corrections(part, frames), zoom[frames])
@@ -144,7 +146,7 @@ def plan_path(
         ceiling, sigma = _ceiling(raw, target, parts), settings.smooth / frame_interval(times)
         floor = 1 - settings.max_stretch / 100
         hold = hold_at(frame_interval(times))
-        image = image_metric(parts, float(K[0, 0]), size[1])
+        image = image_metric(parts, float(K[0, 0]), size[1]) if over_budget else None
         return optimal_path(
             target,
             sources,
@@ -166,7 +168,7 @@ def plan_path(
     if settings.crop == "none":
         need, planner = np.ones(len(O)), "uncropped"
     elif over(path, everything).any():
-        solved = steadiest(path, np.full(len(O), settings.max_zoom))
+        solved = steadiest(path, np.full(len(O), settings.max_zoom), over_budget=True)
         if solved is not None:
             path, need, planner = solved, zoom_of(solved, everything), "optimal"
         else:  # the programme failed: bend, first giving up the slow part of the smoothing
@@ -182,7 +184,7 @@ def plan_path(
                 # cockatoo's middle half 21.24 -> 15.73). Not the smoothed path's bend:
                 # cockatoo's middle third, at a focal length 3.6x too short, so planned
                 # read 15.54 px at distortion 0.578 against 13.81 and 0.942 bent
-                solved = steadiest(path, np.full(len(O), settings.max_zoom))
+                solved = steadiest(path, np.full(len(O), settings.max_zoom), over_budget=True)
                 if solved is not None:
                     path, need, planner = solved, zoom_of(solved, everything), "optimal"
     else:
@@ -194,7 +196,7 @@ def plan_path(
         # A held path (--lock) is as steady as a path gets.
         if settings.method != "lock":
             spent = choose_zoom(need, times, settings.crop, settings.max_zoom, settings.smooth)
-            solved = steadiest(path, spent)
+            solved = steadiest(path, spent, over_budget=False)
             if solved is not None:
                 path, need, planner = solved, zoom_of(solved, everything), "optimal"
     zoom = choose_zoom(need, times, settings.crop, settings.max_zoom, settings.smooth)
