@@ -72,7 +72,7 @@ HOLD = 1e-4
 # A window is planned by the image's motion (:func:`image_metric`) where the target breaks
 # the budget in at least this share of its frames: violent shake, where the trade between
 # the components decides what is left. The rendered 3° and 4° clips of
-# bench/path_bench.py break it in 0.55 and 0.77 of their frames, and read 7.99 and 12.55
+# bench/path_bench.py break it in 0.55 and 0.77 of their frames, and read 7.97 and 12.54
 # px so, against 8.91 and 14.77 (vid.stab 8.62 and 13.13); the real clips of the bench
 # break it in at most 0.28 (cockatoo) and plan as before: planned so in every window (the
 # 2-D path summed about each frame's middle) they read no steadier (lossless mirrored
@@ -499,11 +499,17 @@ def high_passed_velocity(n: int, sigma: float) -> NDArray[np.float64]:
     return B
 
 
+# The shake's quadratic cost (:func:`_shake_cost`): (P, q, T), P's upper triangle in
+# the variables y of δ = T y (T None: y = δ).
+Cost = tuple[sparse.csc_array, NDArray, sparse.csr_array | None]
+
+
 def _shake_cost(
     p0: NDArray, sigma: float, hold: float = HOLD, metric: NDArray | None = None
-) -> tuple[sparse.csc_array, NDArray] | None:
-    """(P, q) of the objective ½ δᵀP δ + qᵀδ = (½ ‖(I - G_σ) Δ(p0 + δ)‖² + ½ η ‖δ‖²) / c₀
-    + const for the target's unrolled path p0 (n, k); None for fewer than 3 frames.
+) -> Cost | None:
+    """(P, q, T) of the objective ½ yᵀP y + qᵀy = (½ ‖(I - G_σ) Δ(p0 + δ)‖² + ½ η ‖δ‖²)
+    / c₀ + const in y, δ = T y, for the target's unrolled path p0 (n, k); None for fewer
+    than 3 frames.
 
     c₀ = ½ ‖(I - G_σ) Δp0‖², the target's own shake, is the unit (at least ``STILL`` a
     frame and component: a held target has none). In rad² the objective
@@ -512,25 +518,30 @@ def _shake_cost(
     upper triangle, the form Clarabel takes, made once for every solve of the window.
     With H = B ⊗ I_k, the operator on the path's n × k values flattened frame-major,
     HᵀH = BᵀB ⊗ I_k: the components do not meet in the cost, so BᵀB is made dense,
-    n × n, and spread over them. The sparse product HᵀH took 0.40 s a window of 300
-    frames and 7 components (240 fps), this 0.04. With a ``metric`` G (k, k), the norms
-    are ‖·‖_G (:func:`image_metric`): HᵀH = BᵀB ⊗ G.
+    n × n, and spread over them (y = δ, T None). The sparse product HᵀH took 0.40 s a
+    window of 300 frames and 7 components (240 fps), this 0.04.
+
+    With a ``metric`` G = LLᵀ (k, k) the norms are ‖·‖_G (:func:`image_metric`) and
+    HᵀH = BᵀB ⊗ G, which couples the components. In y = (I_n ⊗ Lᵀ) δ it is BᵀB ⊗ I_k
+    again, and a frame's rows of the constraints still meet that frame's values alone:
+    a window's solve on the 3° clip of bench/path_bench.py took 0.10–0.17 s so, where
+    BᵀB ⊗ G took 0.15–0.23 (the answers alike to 1e-7).
     """
     n, k = p0.shape
     if n < 3:
         return None
     B = high_passed_velocity(n, sigma)
     shake = B @ p0  # (n - 1, k)
-    if metric is not None:
-        weighed = shake @ metric
-        unit = max(0.5 * float(np.sum(weighed * shake)), STILL * n * k)
-        M = sparse.csr_array(B.T @ B + hold * np.eye(n))
-        P = sparse.triu(sparse.kron(M, sparse.csr_array(metric))) / unit
-        return sparse.csc_array(P), (B.T @ weighed).ravel() / unit
-    unit = max(0.5 * float(np.sum(shake * shake)), STILL * n * k)
+    weighed = shake if metric is None else shake @ metric
+    unit = max(0.5 * float(np.sum(weighed * shake)), STILL * n * k)
     M = np.triu(B.T @ B + hold * np.eye(n)) / unit
-    P = sparse.kron(sparse.csr_array(M), sparse.eye_array(k))
-    return P.tocsc(), (B.T @ shake).ravel() / unit
+    P = sparse.kron(sparse.csr_array(M), sparse.eye_array(k)).tocsc()
+    q = (B.T @ weighed).ravel() / unit
+    if metric is None:
+        return P, q, None
+    inverse = np.linalg.inv(np.linalg.cholesky(metric).T)  # δ_t = L⁻ᵀ y_t
+    T = sparse.kron(sparse.eye_array(n), sparse.csr_array(inverse)).tocsr()
+    return P, T.T @ q, T
 
 
 def _programme(
@@ -538,7 +549,7 @@ def _programme(
     x0: NDArray,
     fixed: int,
     ceiling: NDArray,
-    cost: tuple[sparse.csc_array, NDArray] | None,
+    cost: Cost | None,
 ) -> NDArray | None:
     """Solve the quadratic programme of objective ``cost`` (:func:`_shake_cost`) around
     x0 under the linearised ``crop`` (A, b); None where Clarabel finds no answer.
@@ -583,15 +594,18 @@ def _programme(
 
 
 def _solve(
-    cost: tuple[sparse.csc_array, NDArray],
+    cost: Cost,
     equal: tuple[sparse.csr_array, NDArray],
     below: tuple[sparse.csr_array, NDArray],
 ) -> NDArray | None:
-    """argmin ½ xᵀP x + qᵀx subject to E x = e and A x ≤ b, by Clarabel; None where it
-    finds no answer. ``cost`` (P's upper triangle, q), ``equal`` (E, e), ``below`` (A, b)."""
+    """argmin of the ``cost`` (:func:`_shake_cost`) over x = T y subject to E x = e and
+    A x ≤ b, by Clarabel; None where it finds no answer. ``equal`` (E, e), ``below``
+    (A, b)."""
     import clarabel  # loaded with the first programme, not with the planner
 
-    (P, q), (E, e), (A, b) = cost, equal, below
+    (P, q, T), (E, e), (A, b) = cost, equal, below
+    if T is not None:
+        E, A = E @ T, A @ T
     cones = [clarabel.NonnegativeConeT(A.shape[0])]
     if E.shape[0]:  # Clarabel's zero cone: equalities
         cones.insert(0, clarabel.ZeroConeT(E.shape[0]))
@@ -607,7 +621,7 @@ def _solve(
     solution = solver.solve()
     if solution.status not in (clarabel.SolverStatus.Solved, clarabel.SolverStatus.AlmostSolved):
         return None
-    return np.asarray(solution.x)
+    return np.asarray(solution.x) if T is None else T @ np.asarray(solution.x)
 
 
 def _picking(index: NDArray, size: int) -> sparse.csr_array:

@@ -16,6 +16,7 @@ from stabilize.path.optimal import (
     _programme,
     _shake_cost,
     conformal_split,
+    high_passed_velocity,
     hold_at,
     image_metric,
     optimal_path,
@@ -146,13 +147,13 @@ def test_a_round_steps_no_further_than_the_linearisation_is_trusted():
     """A programme whose rows leave its optimum 5 rad away (a direction the linearised
     corners barely see) steps only TRUST towards it; one within reach is solved whole."""
     n, k = 4, 2
-    cost = (sparse.eye_array(n * k, format="csc"), np.full(n * k, -5.0))  # optimum δ = 5
+    cost = (sparse.eye_array(n * k, format="csc"), np.full(n * k, -5.0), None)  # optimum δ = 5
     no_rows = (sparse.csr_array((0, n * k)), np.zeros(0))
     ceiling = np.full((n, k), np.inf)
     found = _programme(no_rows, np.zeros((n, k)), 1, ceiling, cost)
     assert np.allclose(found[0], 0.0)  # the held frame
     assert np.allclose(found[1:], TRUST, atol=1e-6)
-    near = (sparse.eye_array(n * k, format="csc"), np.full(n * k, -0.5 * TRUST))
+    near = (sparse.eye_array(n * k, format="csc"), np.full(n * k, -0.5 * TRUST), None)
     assert np.allclose(_programme(no_rows, np.zeros((n, k)), 0, ceiling, near), 0.5 * TRUST)
 
 
@@ -313,6 +314,34 @@ def test_the_image_metric_weighs_a_turn_and_a_shift_by_how_they_move_the_frame()
     assert roll @ G @ roll == pytest.approx((4 + 2 * OWN) * (r * eps) ** 2)
     # the turn alone: each axis as far as it moves the frame
     assert np.allclose(image_metric((), 500.0, 640), np.diag([1, 1, r * r]) * (1 + OWN))
+
+
+def test_the_image_metrics_programme_is_solved_in_whitened_variables():
+    """Under a metric G = LLᵀ the cost BᵀB ⊗ G is solved as BᵀB ⊗ I in y = (I ⊗ Lᵀ) δ;
+    the answer, back in δ, is the programme's in δ itself (held frames and crop rows
+    included), and it is not the answer with the components alike."""
+    n, parts = 40, (0, 1, 2, 3)
+    k = 3 + len(parts)
+    p0 = np.cumsum(np.random.default_rng(3).normal(0, 0.01, (n, k)), axis=0)
+    G = image_metric(parts, 500.0, 640)
+    crop = (-sparse.eye_array(n * k, format="csr")[k * 10 : k * 20 : k], -np.full(10, 0.02))
+    x0 = np.zeros((n, k))
+    x0[0] = 0.001
+    ceiling = np.full((n, k), np.inf)
+    whitened = _programme(crop, x0, 1, ceiling, _shake_cost(p0, 5.0, metric=G))
+    P, q, _ = _shake_cost(p0, 5.0)  # the components alike
+    B = high_passed_velocity(n, 5.0)
+    unit = 0.5 * float(np.sum((B @ p0 @ G) * (B @ p0)))
+    M = np.triu(B.T @ B + HOLD * np.eye(n)) / unit
+    direct = (
+        sparse.csc_array(sparse.triu(sparse.kron(M + np.triu(M, 1).T, G))),
+        (B.T @ (B @ p0 @ G)).ravel() / unit,
+        None,
+    )
+    assert np.allclose(whitened, _programme(crop, x0, 1, ceiling, direct), atol=1e-5)
+    assert np.allclose(whitened[0], 0.001) and (whitened[10:20, 0] >= 0.02 - 1e-9).all()
+    alike = _programme(crop, x0, 1, ceiling, (P, q, None))
+    assert np.abs(whitened - alike).max() > 1e-3
 
 
 def test_a_window_the_budget_binds_in_is_planned_by_the_images_motion():
