@@ -157,6 +157,26 @@ def test_a_round_steps_no_further_than_the_linearisation_is_trusted():
     assert np.allclose(_programme(no_rows, np.zeros((n, k)), 0, ceiling, near), 0.5 * TRUST)
 
 
+def test_a_level_component_keeps_one_deviation_over_the_window():
+    """The 2-D angle, level in a window weighed by the image's metric, keeps the held
+    frames' last deviation (or x0's first) though the shake would have it move."""
+    n, k = 30, 7
+    p0 = np.zeros((n, k))
+    p0[:, 5] = 0.01 * np.sin(np.arange(n))  # a shaking 2-D angle the cost would undo
+    x0 = np.zeros((n, k))
+    x0[:2, 5] = [0.003, 0.004]  # the held frames'
+    ceiling = np.full((n, k), np.inf)
+    no_rows = (sparse.csr_array((0, n * k)), np.zeros(0))
+    cost = _shake_cost(p0, 3.0)
+    free = _programme(no_rows, x0, 2, ceiling, cost)
+    assert np.ptp(free[2:, 5]) > 1e-3  # without: it moves
+    level = _programme(no_rows, x0, 2, ceiling, cost, (5,))
+    assert np.allclose(level[:2], x0[:2]) and np.allclose(level[2:, 5], 0.004, atol=1e-9)
+    assert np.allclose(level[:, :5], free[:, :5], atol=1e-7)  # the others as they were
+    first = _programme(no_rows, x0, 0, ceiling, cost, (5,))
+    assert np.allclose(first[:, 5], 0.003, atol=1e-9)
+
+
 def test_a_held_target_is_solved():
     """A held target (--lock) has no shake of its own but its rounding (1e-37 rad² on
     phone-cc9): scaled by that, P was 1e34 and Clarabel found no answer, so every held
