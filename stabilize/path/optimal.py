@@ -74,7 +74,7 @@ HOLD = 1e-4
 # A window is planned by the image's motion (:func:`image_metric`) where the target breaks
 # the budget in at least this share of its frames: violent shake, where the trade between
 # the components decides what is left. The rendered 3° and 4° clips of
-# bench/path_bench.py break it in 0.55 and 0.77 of their frames, and read 7.97 and 12.54
+# bench/path_bench.py break it in 0.55 and 0.77 of their frames, and read 8.07 and 12.48
 # px so, against 8.91 and 14.77 (vid.stab 8.62 and 13.13); the real clips of the bench
 # break it in at most 0.28 (cockatoo) and plan as before: planned so in every window (the
 # 2-D path summed about each frame's middle) they read no steadier (lossless mirrored
@@ -533,8 +533,8 @@ def _shake_cost(
     With a ``metric`` G = LLᵀ (k, k) the norms are ‖·‖_G (:func:`image_metric`) and
     HᵀH = BᵀB ⊗ G, which couples the components. In y = (I_n ⊗ Lᵀ) δ it is BᵀB ⊗ I_k
     again, and a frame's rows of the constraints still meet that frame's values alone:
-    a window's solve on the 3° clip of bench/path_bench.py took 0.10–0.17 s so, where
-    BᵀB ⊗ G took 0.15–0.23 (the answers alike to 1e-7).
+    a window's solve on the 3° clip of bench/path_bench.py took 0.10–0.20 s so, where
+    BᵀB ⊗ G took 0.15–0.29 (the answers alike to 1e-7).
     """
     n, k = p0.shape
     if n < 3:
