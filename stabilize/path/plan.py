@@ -93,6 +93,7 @@ def plan_path(
     if not measured:
         residual = np.zeros((len(rotations), 4))
     raw = Trajectory(orientations_from_rotations(rotations), planar.path_of(residual))
+    held = settings.method == "lock"  # --lock: one orientation, the 2-D path held too
     O = raw.turn
     planned_so_far = 0
 
@@ -104,8 +105,7 @@ def plan_path(
 
     def planned(smooth: float) -> Trajectory:
         S = smooth_orientations(O, times, smooth, settings.method)
-        hold = settings.method == "lock"
-        return Trajectory(S, planar.smooth_path(raw.shift, times, smooth, settings.motion, hold))
+        return Trajectory(S, planar.smooth_path(raw.shift, times, smooth, settings.motion, held))
 
     framing = Framing(K, size, None if rolling is None else rolling.rows, lens)
     # The stretch bound is the middle row's: a rolling shutter's shear undoes the one the
@@ -169,7 +169,7 @@ def plan_path(
     if settings.crop == "none":
         need, planner = np.ones(len(O)), "uncropped"
     elif over(path, everything).any():
-        held = settings.method == "lock"
+        budget = np.full(len(O), settings.max_zoom)
         # A held path is planned from its bend (below) alone. Started from the held path,
         # far over the budget, the programme's rounds ended at paths less steady, and
         # slowly: with --lock (the means of four mirrored lossless readings) karma read
@@ -179,7 +179,7 @@ def plan_path(
         # and 14.07 (distortion mirrored 0.984 / 0.979 and 0.977 / 0.968)
         solved = None
         if not held:
-            solved = steadiest(path, np.full(len(O), settings.max_zoom), over_budget=True)
+            solved = steadiest(path, budget, over_budget=True)
         if solved is not None:
             path, need, planner = solved, zoom_of(solved, everything), "optimal"
         else:  # held, or the programme failed: bend, first giving up the slow part of the
@@ -198,7 +198,7 @@ def plan_path(
                 # read 15.54 px at distortion 0.578 against 13.81 and 0.942 bent; and
                 # planned from their bends, path_bench's violent clips read 3° 8.05 ->
                 # 8.79 px, 4° 12.48 -> 14.61 (lossless, four mirrored readings' means)
-                solved = steadiest(path, np.full(len(O), settings.max_zoom), over_budget=True)
+                solved = steadiest(path, budget, over_budget=True)
                 if solved is not None:
                     path, need, planner = solved, zoom_of(solved, everything), "optimal"
     else:
@@ -208,7 +208,7 @@ def plan_path(
         # mode would choose it) read 1.257 -> 1.109 px on phone-cc9's frames, 0.721 ->
         # 0.646 on the rendered 100 degree walk (means of the four mirrored readings).
         # A held path (--lock) is as steady as a path gets.
-        if settings.method != "lock":
+        if not held:
             spent = choose_zoom(need, times, settings.crop, settings.max_zoom, settings.smooth)
             solved = steadiest(path, spent, over_budget=False)
             if solved is not None:
