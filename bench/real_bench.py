@@ -28,7 +28,9 @@ motion, so the same shake, but other features and other RANSAC draws. The range 
 four readings is the metric's own uncertainty on that clip, which a difference between
 the tools must exceed to mean anything (max-heromode: ours 0.921–0.988, vid.stab
 0.944–1.009; hero7: 1.305–1.335 against 1.118–1.194), and their mean a steadier reading;
-the median ratio is then given of the means too.
+the median ratio is then given of the means too. (The figures quoted here were read before
+the registration was refined to a fraction of a pixel, on 7 December; the README's
+real-footage section gives the bench read both ways.)
 
 ``--out-crf`` sets the CRF both tools' output (and the crop) is encoded at (18, as our
 default encodes it). At 0 the encode is lossless and the rows read the geometry alone:

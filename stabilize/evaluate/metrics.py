@@ -16,9 +16,10 @@
   consecutive frames (of the registration's linear part at the centre) that no
   similarity has, in px at the clip's width: a rolling shutter's jello. Lower is better.
 
-Registrations are ORB features, spread evenly over a grid, matched with a ratio test,
-then a RANSAC homography; frames with too few features fall back to the identity (and are
-counted).
+Registrations are ORB features, spread evenly over a grid, matched with a ratio test
+(between consecutive frames, each match then refined to a fraction of a pixel:
+:func:`stabilize.evaluate.shake.subpixel`), then a RANSAC homography; frames with too few
+features fall back to the identity (and are counted).
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ from stabilize.evaluate.shake import (
     principal_spread,
     residual_shake,
     similarity_motion,
+    subpixel,
 )
 from stabilize.evaluate.wobble import non_similar_part, wobble
 from stabilize.progress import Progress, no_progress
@@ -49,7 +51,8 @@ LOW_BAND = slice(1, 6)  # the 2nd to the 6th FFT components (index 0 is DC)
 REGISTRATION_LONG_SIDE = 640
 
 
-def _grey(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+def registration_grey(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """The frame in grey, shrunk to ``REGISTRATION_LONG_SIDE`` on its long side."""
     grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY) if frame.ndim == 3 else frame
     scale = REGISTRATION_LONG_SIDE / max(grey.shape)
     if scale < 1:
@@ -65,8 +68,11 @@ class Registrar:
         self.matcher = cv2.BFMatcher(cv2.NORM_HAMMING)
         self.failures = 0
 
-    def features(self, frame: NDArray[np.uint8]):
-        grey = _grey(frame)
+    def features(self, frame: NDArray[np.uint8], grey: NDArray[np.uint8] | None = None):
+        """(points in the frame's pixels, descriptors) of ORB features spread over
+        ``frame``, found on ``grey``, its grey image at the registration's size
+        (:func:`registration_grey`; made here if not given)."""
+        grey = registration_grey(frame) if grey is None else grey
         scale = frame.shape[1] / grey.shape[1]
         kp = spread(self.orb.detect(grey, None), grey.shape)
         kp, desc = self.orb.compute(grey, kp)
@@ -205,7 +211,8 @@ class _Clip:
         self.reg = Registrar()
         self.inter: list[NDArray] = []
         self.itf: list[float] = []
-        self.previous: tuple | None = None  # (features, grey) of the last frame
+        # (features, grey, grey at the registration's size) of the last frame
+        self.previous: tuple | None = None
         self.frames = 0
         self.motions: list[NDArray] = []  # frame-to-frame similarities (dx, dy, dθ, d ln s)
         self.skews: list[NDArray] = []  # their homographies' non-similar parts (wobble)
@@ -213,11 +220,14 @@ class _Clip:
 
     def add(self, frame: NDArray[np.uint8]):
         """Register a frame against the previous one; returns its features."""
-        feat = self.reg.features(frame)
+        small = registration_grey(frame)
+        feat = self.reg.features(frame, small)
         grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
         if self.previous is not None:
             width = frame.shape[1]
             matched = matched_points(self.previous[0], feat, self.reg.matcher)  # once, for both
+            if matched is not None:  # to a fraction of a pixel (:func:`subpixel`)
+                matched = subpixel(self.previous[2], small, *matched, width / small.shape[1])
             self.inter.append(self.reg.fit(matched, width))
             motion = None if matched is None else similarity_motion(*matched, width)
             self.motions.append(np.zeros(4) if motion is None else motion)
@@ -225,7 +235,7 @@ class _Clip:
                 centre = ((frame.shape[1] - 1) / 2, (frame.shape[0] - 1) / 2)
                 self.skews.append(non_similar_part(jacobian(self.inter[-1], centre)))
             self.itf.append(psnr(self.previous[1], grey))
-        self.previous = (feat, grey)
+        self.previous = (feat, grey, small)
         self.frames += 1
         self.shape = frame.shape
         return feat
