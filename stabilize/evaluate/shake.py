@@ -2,8 +2,8 @@
 
 Consecutive frames are registered by a similarity (ORB features spread over the frame,
 each match refined to a fraction of a pixel by :func:`subpixel`, RANSAC), the 2-D motion
-a viewer's eye follows. Each frame-to-frame similarity becomes a
-motion vector in pixels at the clip's width w,
+a viewer's eye follows. Each frame-to-frame similarity becomes a motion vector in pixels
+at the clip's width w,
 
     v_t = (dx, dy, dθ · w/2, d(ln s) · w/2),
 

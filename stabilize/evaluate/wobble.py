@@ -5,8 +5,7 @@ shears the columns (x moves with y), a pitch stretches or squeezes the rows. As 
 changes from frame to frame, consecutive frames differ by a shear and a stretch, which
 the viewer sees as jello. Consecutive frames are registered by a homography (the ORB
 registration of :mod:`stabilize.evaluate.metrics`, refined to a fraction of a pixel); of
-its linear part at the frame's
-centre, J = [[a, b], [c, d]], the part no similarity has,
+its linear part at the frame's centre, J = [[a, b], [c, d]], the part no similarity has,
 
     ε = ((a - d) / 2, (b + c) / 2),
 
