@@ -220,9 +220,9 @@ class _Clip:
 
     def add(self, frame: NDArray[np.uint8]):
         """Register a frame against the previous one; returns its features."""
-        small = registration_grey(frame)
-        feat = self.reg.features(frame, small)
         grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
+        small = registration_grey(grey)  # (grey once: the PSNR's and the registration's)
+        feat = self.reg.features(frame, small)
         if self.previous is not None:
             width = frame.shape[1]
             matched = matched_points(self.previous[0], feat, self.reg.matcher)  # once, for both
