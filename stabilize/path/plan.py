@@ -182,8 +182,8 @@ def plan_path(
             solved = steadiest(path, budget, over_budget=True)
         if solved is not None:
             path, need, planner = solved, zoom_of(solved, everything), "optimal"
-        else:  # held, or the programme failed: bend, first giving up the slow part of the
-            # smoothing
+        else:
+            # held, or the programme failed: bend, first giving up the smoothing's slow part
             looser = planned(settings.smooth * LOOSER)
             path, need = respect_zoom_budget(
                 raw, path, times, zoom_of, settings.max_zoom, settings.smooth, (looser,), over

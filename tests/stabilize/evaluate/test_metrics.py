@@ -67,6 +67,20 @@ def test_the_spread_reads_the_same_motion_mirrored(shaken):
     assert figures["mean"] == pytest.approx(np.mean(readings))
 
 
+def test_the_spread_reads_at_other_registration_sizes_too(shaken):
+    # The 2 px jitter (frames 304 px wide), registered at 288 px as it is and mirrored three
+    # ways, and at its own size mirrored: 2 px each time
+    jittered = [np.roll(shaken[0], 2 * (k % 2), axis=1)[:, 8:-8] for k in range(60)]
+    as_it_is = evaluate(jittered).residual_shake_px
+    finer = shake_spread(jittered, as_it_is, sizes=(288, 640)).readings
+    assert len(finer) == 8 and finer[0] == as_it_is
+    assert finer == pytest.approx([2.0] * 8, rel=0.1)
+    assert finer[5:] == shake_spread(jittered, as_it_is).readings[1:]
+    # On the shaken street, other registrations than the frames' own size's
+    street = shake_spread(shaken, evaluate(shaken).residual_shake_px, sizes=(288,)).readings
+    assert len(street) == 5 and len(set(street)) == 5
+
+
 def test_a_zoomed_crop_ranks_below_an_uncropped_one(shaken):
     def zoom(frame: np.ndarray, z: float) -> np.ndarray:
         h, w = frame.shape[:2]
