@@ -223,8 +223,9 @@ class _Clip:
         self.shape: tuple[int, ...] = ()
 
     def add(self, frame: NDArray[np.uint8]):
-        """Register a frame against the previous one; returns its features."""
-        grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)
+        """Register a frame (RGB, or already grey) against the previous one; returns its
+        features."""
+        grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY) if frame.ndim == 3 else frame
         small = registration_grey(grey, self.long_side)  # (grey once: PSNR's, registration's)
         feat = self.reg.features(frame, small)
         if self.previous is not None:
@@ -404,8 +405,9 @@ def shake_spread(
     ]
     clips = [_Clip(size) for size, _ in views]
     for frame in frames:
+        grey = cv2.cvtColor(frame, cv2.COLOR_RGB2GRAY)  # once: a mirror's grey is grey's mirror
         for clip, (_, mirror) in zip(clips, views, strict=True):
-            clip.add(np.ascontiguousarray(frame[mirror]))
+            clip.add(np.ascontiguousarray(grey[mirror]))
         progress(1)
     readings = (as_it_is, *(c.metrics([], [], fps).residual_shake_px for c in clips))
     return ShakeSpread(tuple(float(r) for r in readings))
