@@ -23,11 +23,15 @@ expected to read much under its outputs.
     python bench/motion_bench.py
     python bench/motion_bench.py --fov 45 --max-zoom 1.15
     python bench/motion_bench.py --spread          # mirrored means: slower, steadier
+    python bench/motion_bench.py --spread --sizes  # 20 readings each: slower still, finer
     python bench/motion_bench.py --out-crf 0 --only distant   # the geometry alone
 
 ``--out-crf`` sets the CRF every output is encoded at (18, the default's; 0: lossless,
 so that a row reads the warps and not x264's response to them: real_bench's); ``--only``
-keeps the rendered scenes whose names start with one of its words.
+keeps the rendered scenes whose names start with one of its words. With ``--sizes`` the
+mean is of 20 readings: the four mirrored ones at each of the registration's five sizes
+(real_bench's), since the four share where the registration's grid falls on the
+picture, which moves their mean by about ±3%.
 """
 
 from __future__ import annotations
@@ -41,7 +45,12 @@ from pathlib import Path
 import numpy as np
 
 from stabilize import Settings, stabilize_video
-from stabilize.evaluate.metrics import evaluate, evaluate_against
+from stabilize.evaluate.metrics import (
+    REGISTRATION_LONG_SIDE,
+    SPREAD_SIZES,
+    evaluate,
+    evaluate_against,
+)
 from stabilize.path.residual import MOTION_MODELS
 from stabilize.synth import SynthOptions, render_clip
 from stabilize.video import probe, read_frames
@@ -67,10 +76,15 @@ def variants(fov: float) -> dict[str, SynthOptions]:
     }
 
 
-def shakes(clip: Path, outs: list[Path], spread: bool = False) -> list[tuple[float, float, float]]:
+def shakes(
+    clip: Path,
+    outs: list[Path],
+    spread: bool = False,
+    sizes: tuple[int, ...] = (REGISTRATION_LONG_SIDE,),
+) -> list[tuple[float, float, float]]:
     """(residual shake px, distortion, crop) of each of ``outs``, stabilised from ``clip``
     and read in one pass over it; with ``spread``, the shake is the mean of its four
-    mirrored readings."""
+    mirrored readings at each of the registration's ``sizes``."""
     info = probe(clip)
     outputs = [read_frames(out, info.size) for out in outs]
     _, found = evaluate_against(read_frames(clip), outputs, info.fps)
@@ -78,24 +92,30 @@ def shakes(clip: Path, outs: list[Path], spread: bool = False) -> list[tuple[flo
     for out, metrics in zip(outs, found, strict=True):
         px = metrics.residual_shake_px
         if spread:
-            px = float(np.mean(mirrored(out, info.size, info.fps, metrics)))
+            px = float(np.mean(mirrored(out, info.size, info.fps, metrics, sizes)))
         readings.append((px, metrics.distortion, metrics.cropping_ratio))
     return readings
 
 
 def row(
-    clip: Path, folder: Path, fov: float | None, max_zoom: float, spread: bool, crf: int
+    clip: Path,
+    folder: Path,
+    fov: float | None,
+    max_zoom: float,
+    crf: int,
+    spread: bool = False,
+    sizes: tuple[int, ...] = (REGISTRATION_LONG_SIDE,),
 ) -> tuple[str, str, str]:
     """The table's cells for ``clip`` stabilised with every ``--motion`` (at ``fov``;
     None: as a user would run it, the focal length found from the clip) and encoded at
-    ``crf``: the shake of each, with its ratio to the rotation-only run's, then
-    distortion and crop."""
+    ``crf``: the shake of each (read as :func:`shakes` does), with its ratio to the
+    rotation-only run's, then distortion and crop."""
     encoding = Encoding(crf=crf)
     outs = [folder / f"{motion}.mp4" for motion in MOTION_MODELS]
     for motion, out in zip(MOTION_MODELS, outs, strict=True):
         settings = Settings(motion=motion, fov=fov, max_zoom=max_zoom, encoding=encoding)
         stabilize_video(clip, out, settings, overwrite=True)
-    readings = shakes(clip, outs, spread)
+    readings = shakes(clip, outs, spread, sizes)
     base = readings[0][0]
     cells = " | ".join(f"{r[0]:.3f} ({r[0] / base:.2f})" for r in readings)
     dist = " / ".join(f"{r[1]:.3f}" for r in readings)
@@ -108,6 +128,11 @@ def main() -> None:
     parser.add_argument("--max-zoom", type=float, default=1.5)
     parser.add_argument("--spread", action="store_true", help="mean of four mirrored readings")
     parser.add_argument(
+        "--sizes",
+        action="store_true",
+        help="with --spread, read at the registration's five sizes too (20 readings)",
+    )
+    parser.add_argument(
         "--out-crf",
         type=crf_option,
         default=DEFAULT_CRF["libx264"],
@@ -115,6 +140,9 @@ def main() -> None:
     )
     parser.add_argument("--only", nargs="+", help="keep the scenes named so (e.g. distant)")
     args = parser.parse_args()
+    if args.sizes and not args.spread:
+        parser.error("--sizes reads the spread: give --spread too")
+    sizes = SPREAD_SIZES if args.sizes else (REGISTRATION_LONG_SIDE,)
     work = Path(tempfile.mkdtemp(prefix="motion-bench-"))
     motions = list(MOTION_MODELS)
     print(f"clips and outputs in {work}; --max-zoom {args.max_zoom}, true field of view,")
@@ -128,7 +156,9 @@ def main() -> None:
             folder = work / f"{int(fov)}-{name.split()[0]}"
             render_clip(folder, opts)
             clip = folder / "clip.mp4"
-            cells, dist, crop = row(clip, folder, fov, args.max_zoom, args.spread, args.out_crf)
+            cells, dist, crop = row(
+                clip, folder, fov, args.max_zoom, args.out_crf, args.spread, sizes
+            )
             original = evaluate(read_frames(clip), opts.fps).residual_shake_px
             print(f"| {fov:g}° | {name} | {original:.3f} | {cells} | {dist} | {crop} |")
     # karma as a user's run: its field of view found from it, the default budget
@@ -136,7 +166,7 @@ def main() -> None:
         folder = work / "karma"
         folder.mkdir()
         zoom = Settings().max_zoom
-        cells, dist, crop = row(KARMA, folder, None, zoom, args.spread, args.out_crf)
+        cells, dist, crop = row(KARMA, folder, None, zoom, args.out_crf, args.spread, sizes)
         original = evaluate(read_frames(KARMA), probe(KARMA).fps).residual_shake_px
         print(f"| real | karma (distant) | {original:.3f} | {cells} | {dist} | {crop} |")
 

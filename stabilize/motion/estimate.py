@@ -7,8 +7,11 @@ rotation is also estimated from horizontal bands of the frame alone, which dates
 rows of a rolling-shutter frame (:attr:`VisualTrack.bands`). The similarity each
 rotation leaves in the frame (the parallax of a walk) is measured on the background's
 vectors, those that land within a few pixels of where the rotation puts them
-(:mod:`stabilize.motion.residual`). At a high frame rate the flow between frames a
-thirtieth of a second apart is sampled too, and kept (:mod:`stabilize.motion.strides`).
+(:mod:`stabilize.motion.residual`), refined first by Lucas–Kanade at the working size
+(:func:`flow.refine.refine_at`): DIS's own error, shared by neighbouring vectors, was
+all that measure read on a scene the rotation explains. At a high frame rate the flow
+between frames a thirtieth of a second apart is sampled too, and kept
+(:mod:`stabilize.motion.strides`).
 
 Only the vectors measured where the first frame has texture in two directions
 (:mod:`flow.texture`) vote for the frame's rotation and measure what it leaves: on a
@@ -33,6 +36,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 import flow
+from flow.base import to_grey
+from flow.refine import refine_at
 from flow.resize import WorkingSize
 from flow.texture import textured
 from rotation import HoughEstimator
@@ -92,10 +97,11 @@ def estimate_rotations(
     residual: list[NDArray] = []
     masks = band_masks(estimator, ws.size[0], voted)
     textures: deque[NDArray] = deque()  # each frame's measurable vectors, until its pair
+    greys: deque[NDArray] = deque()  # each frame in grey, until its pair is refined
     likenesses: list[float] = []  # each pair's (cuts.likeness)
     resumed: list[int] = []  # ... and, where unlike, how far back its picture resumes
     pictures = _noting_likeness(frames, likenesses, resumed)
-    noted = _noting_texture(pictures, estimator.grid, textures)
+    noted = _noting_texture(pictures, estimator.grid, textures, greys)
     strides: list[tuple] = []  # each stride's (u, v, valid, measured), while it streams
     if every >= 2:
         noted = _noting_strides(noted, every, backend, estimator, strides)
@@ -107,6 +113,7 @@ def estimate_rotations(
     with ThreadPoolExecutor(1) as voter:
         for u, v, valid in _sampled(estimator, backend.many(noted)):
             measured = valid & np.stack([textures.popleft() for _ in range(len(u))])
+            fine = _refined(estimator.grid, greys, u, v, measured)
             if voting is not None:
                 residual.append(_voted(voting, progress))
             if settle and len(found[0]) >= settle.after:  # asked once
@@ -122,9 +129,9 @@ def estimate_rotations(
                     keeping = keep_samples
                     kept = kept if keeping else []
                 settle = None
-            voting = voter.submit(_vote, estimator, u, v, valid, measured, masks, found)
+            voting = voter.submit(_vote, estimator, u, v, valid, measured, masks, found, fine)
             if keeping:
-                kept.append((u.astype(np.float32), v.astype(np.float32), valid, measured))
+                kept.append((u.astype(np.float32), v.astype(np.float32), valid, measured, *fine))
         if voting is not None:
             residual.append(_voted(voting, progress))
     n = len(found[0]) + 1
@@ -221,21 +228,27 @@ def _revoted(
     array each) of every pair of ``samples``, voted again by ``estimator``."""
     found: list[list[tuple]] = [[] for _ in range(len(masks) + 1)]
     residual = []
+    fine_u, fine_v = samples.fine
     for part in _chunks(len(samples.u)):
         u, v, valid = samples.u[part], samples.v[part], samples.valid[part]
-        residual.append(_vote(estimator, u, v, valid, samples.voting[part], masks, found))
+        fine = (fine_u[part], fine_v[part])
+        residual.append(_vote(estimator, u, v, valid, samples.voting[part], masks, found, fine))
     return found, residual
 
 
 def _samples(kept: list[tuple], estimator: HoughEstimator, ws: WorkingSize) -> Samples:
-    """The kept chunks' (u, v, valid, measured) as one :class:`Samples`."""
+    """The kept chunks' (u, v, valid, measured, fine u, fine v) as one :class:`Samples`."""
     grid = estimator.grid
-    u, v, valid, measured = (np.concatenate(parts) for parts in zip(*kept, strict=True))
+    u, v, valid, measured, fine_u, fine_v = (
+        np.concatenate(parts) for parts in zip(*kept, strict=True)
+    )
     return Samples(
         u,
         v,
         valid,
         measured=measured,
+        fine_u=fine_u,
+        fine_v=fine_v,
         x=grid.x,
         y=grid.y,
         rows=np.repeat(grid.rows, len(grid.cols)).astype(np.float64),
@@ -320,13 +333,37 @@ def lens_estimator(lens: Lens, ws: WorkingSize, max_deg: float) -> HoughEstimato
 
 
 def _noting_texture(
-    frames: Iterator[NDArray], grid: SampleGrid, textures: deque[NDArray]
+    frames: Iterator[NDArray], grid: SampleGrid, textures: deque[NDArray], greys: deque[NDArray]
 ) -> Iterator[NDArray]:
     """The frames as they are, noting in ``textures`` where each has the texture to
-    measure flow at the sample grid (:func:`flow.texture.textured`)."""
+    measure flow at the sample grid (:func:`flow.texture.textured`), and in ``greys``
+    the frame in grey, for its pairs' vectors to be refined (:func:`_refined`)."""
     for frame in frames:
         textures.append(textured(frame, grid.rows, grid.cols))
+        greys.append(to_grey(frame))
         yield frame
+
+
+def _refined(
+    grid: SampleGrid, greys: deque[NDArray], u: NDArray, v: NDArray, measured: NDArray
+) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+    """The vectors u, v (n, M) of the n pairs that the first n + 1 of ``greys`` make,
+    refined by Lucas–Kanade at the grid's points where ``measured`` (n, M)
+    (:func:`flow.refine.refine_at`), the others as they are: only those measure what a
+    rotation leaves. The first n greys are dropped, their pairs done."""
+    x, y = _grid_pixels(grid)
+    fine_u, fine_v = u.astype(np.float32), v.astype(np.float32)
+    for k, at in enumerate(measured):
+        earlier = greys.popleft()
+        fine_u[k, at], fine_v[k, at] = refine_at(
+            earlier, greys[0], x[at], y[at], u[k, at], v[k, at]
+        )
+    return fine_u, fine_v
+
+
+def _grid_pixels(grid: SampleGrid) -> tuple[NDArray, NDArray]:
+    """The grid's points as (column, row) pixel positions (M,), in the samples' order."""
+    return np.tile(grid.cols, len(grid.rows)), np.repeat(grid.rows, len(grid.cols))
 
 
 def _noting_strides(
@@ -347,7 +384,8 @@ def _noting_strides(
             if key is not None:
                 u, v, valid = estimator.samples(backend(key, frame)[None])
                 measured = valid & textured(key, grid.rows, grid.cols)
-                strides.append((u.astype(np.float32), v.astype(np.float32), valid, measured))
+                kept = (u.astype(np.float32), v.astype(np.float32), valid, measured)
+                strides.append((*kept, *_refined(grid, deque([key, frame]), u, v, measured)))
             key = frame
         yield frame
 
@@ -407,15 +445,16 @@ def _vote(
     measured: NDArray,
     masks: list[NDArray],
     found: list[list[tuple]],
+    fine: tuple[NDArray, NDArray],
 ) -> NDArray:
     """(R, support, mean row) of each pair into ``found``: the whole frame from the
     ``measured`` vectors, then each band (its mask in ``masks``) from its ``valid``
     ones; returns the similarity (n, 4) each whole-frame rotation leaves on the measured
-    vectors."""
+    vectors, refined (``fine``: their u, v)."""
     grid = estimator.grid
     votes = [measured, *(valid & mask for mask in masks)]
     R = np.array([est.matrix for est in _vote_sets(estimator, u, v, votes, found)[0]])
-    return residual_motion(grid.x, grid.y, u, v, measured, R, estimator.focal)
+    return residual_motion(grid.x, grid.y, *fine, measured, R, estimator.focal)
 
 
 def _vote_sets(

@@ -35,7 +35,9 @@ class Samples:
     """The flow vectors pass 1 read at the estimator's sample grid, kept (float32, about
     5 KB a pair) so that the rotations can be estimated again without decoding: with
     another focal length (:mod:`stabilize.motion.focal`), or what they leave measured
-    again once a rolling shutter's rows are dated (:mod:`stabilize.shutter.residual`)."""
+    again once a rolling shutter's rows are dated (:mod:`stabilize.shutter.residual`).
+    The rotations are voted from the flow's vectors; what they leave is measured on the
+    same vectors refined by Lucas–Kanade (:func:`flow.refine.refine_at`), where kept."""
 
     u: NDArray[np.float32]  # (N-1, M)
     v: NDArray[np.float32]
@@ -49,14 +51,35 @@ class Samples:
     # the valid vectors where the first frame had the texture to measure (flow.texture):
     # these vote for the frame's rotation and measure what it leaves (None: every valid one)
     measured: NDArray[np.bool_] | None = None
+    # (N-1, M) each the same vectors refined by Lucas–Kanade at the working size, for
+    # what the rotation leaves (:mod:`stabilize.motion.residual`); None: the flow's
+    fine_u: NDArray[np.float32] | None = None
+    fine_v: NDArray[np.float32] | None = None
 
     def pairs(self, first: int, stop: int) -> Samples:
         """The pairs first..stop-1."""
         part = slice(first, stop)
-        measured = None if self.measured is None else self.measured[part]
+
+        def cut(a: NDArray | None) -> NDArray | None:
+            return None if a is None else a[part]
+
         return replace(
-            self, u=self.u[part], v=self.v[part], valid=self.valid[part], measured=measured
+            self,
+            u=self.u[part],
+            v=self.v[part],
+            valid=self.valid[part],
+            measured=cut(self.measured),
+            fine_u=cut(self.fine_u),
+            fine_v=cut(self.fine_v),
         )
+
+    @property
+    def fine(self) -> tuple[NDArray, NDArray]:
+        """(u, v) (N-1, M) of the vectors what a rotation leaves is measured on: refined
+        where they were, else the flow's."""
+        if self.fine_u is None or self.fine_v is None:
+            return self.u, self.v
+        return self.fine_u, self.fine_v
 
     @property
     def voting(self) -> NDArray[np.bool_]:

@@ -35,9 +35,10 @@ def rectified_residual(
     ray = np.stack([x, y, np.full_like(x, f)], 1)
     to_input = height / samples.height  # flow rows → input rows (pixel centres)
     out = []
+    fine_u, fine_v = samples.fine  # the refined vectors, as pass 1 measured them
     for first in range(0, len(samples.u), CHUNK):
         part = slice(first, first + CHUNK)
-        u, v = samples.u[part].astype(np.float64), samples.v[part].astype(np.float64)
+        u, v = fine_u[part].astype(np.float64), fine_v[part].astype(np.float64)
         k = np.arange(first, first + len(u))
         start = rolling.at(k, (samples.rows + 0.5) * to_input - 0.5)
         end = rolling.at(k + 1, (samples.rows + v + 0.5) * to_input - 0.5)

@@ -70,6 +70,19 @@ def test_evaluate_reads_the_shake_mirrored_too(second):
     assert text.exit_code == 0 and "residual shake mirrored (px): original" in text.stdout
 
 
+def test_evaluate_reads_the_spread_at_five_sizes(second):
+    args = ["evaluate", second, second, "--spread", "--sizes", "--json", "-q"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    metrics = json.loads(result.stdout)["stabilised"]
+    spread = metrics["residual_shake_spread_px"]
+    assert len(spread["readings"]) == 20  # four mirrorings at each of five sizes
+    assert spread["readings"][0] == metrics["residual_shake_px"]
+    assert spread["min"] <= spread["mean"] <= spread["max"]
+    alone = CliRunner().invoke(app, ["evaluate", second, second, "--sizes"])
+    assert alone.exit_code == 2 and "give --spread too" in alone.output
+
+
 def test_evaluate_draws_the_shake(sample, tmp_path):
     png = tmp_path / "shake.png"
     result = CliRunner().invoke(app, ["evaluate", sample, sample, "--plot", str(png), "-q"])

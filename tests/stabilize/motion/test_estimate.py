@@ -126,3 +126,32 @@ def test_a_focal_length_settled_mid_stream_votes_as_if_given():
     assert kept.bands is None and kept.samples is not None
     np.testing.assert_array_equal(kept.rotations, start.rotations)
     np.testing.assert_array_equal(kept.samples.u, start.samples.u)
+
+
+def test_the_rotations_are_voted_from_the_flow_and_what_they_leave_from_refined_vectors():
+    """The vote reads DIS's vectors; the similarity each rotation leaves is measured on
+    the same vectors refined by Lucas–Kanade (flow.refine), which pass 1 keeps beside
+    them, so that it is measured alike when the rotations are voted again."""
+    from stabilize.motion.residual import residual_motion
+
+    clip = SAMPLE / "clip.mp4"
+    info = probe(clip)
+    settings = Settings(fov=70.0)
+    track = estimate.estimate_rotations(clip, info, settings, keep_samples=True)
+    samples = track.samples
+    assert samples.fine_u is not None and samples.fine_u.shape == samples.u.shape
+    moved = np.hypot(samples.fine_u - samples.u, samples.fine_v - samples.v)[samples.voting]
+    assert 0.005 < np.median(moved) < 0.5  # a fraction of a pixel
+    ws = flow.working_size(info.size)
+    focal = settings.focal_px(info.size) * ws.scale[0]
+    estimator = estimate.HoughEstimator(ws.size, focal, max_deg=settings.max_deg)
+    voted = estimator.estimate_samples(samples.u, samples.v, samples.voting)
+    np.testing.assert_array_equal(np.array([e.matrix for e in voted]), track.rotations)
+    left = residual_motion(
+        samples.x, samples.y, *samples.fine, samples.voting, track.rotations, focal
+    )
+    np.testing.assert_allclose(track.residual, left, atol=1e-12)
+    again = estimate.estimate_again(estimator, track)
+    np.testing.assert_allclose(again.residual, track.residual, atol=1e-12)
+    part = samples.pairs(10, 20)
+    np.testing.assert_array_equal(part.fine_u, samples.fine_u[10:20])
