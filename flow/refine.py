@@ -52,6 +52,8 @@ def refine_at(
     v = np.asarray(v, np.float32)
     points = np.stack([np.asarray(x, np.float32), np.asarray(y, np.float32)], 1)
     finite = np.isfinite(u) & np.isfinite(v)
+    if not finite.any():  # (OpenCV refuses an empty set of points)
+        return u, v
     guess = points + np.stack([np.where(finite, u, 0), np.where(finite, v, 0)], 1)
     criteria = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, ITERATIONS, EPSILON_PX)
     found, status, _ = cv2.calcOpticalFlowPyrLK(

@@ -58,3 +58,14 @@ def test_grey_and_colour_frames_give_the_same_vectors():
     again = refine_at(grey0, grey1, x, y, u, v)
     np.testing.assert_array_equal(colour[0], again[0])
     np.testing.assert_array_equal(colour[1], again[1])
+
+
+def test_no_points_or_no_vectors_give_what_was_given():
+    # a black frame has no texture: pass 1 refines none of its pair's points
+    frame0, frame1 = shifted_pair(60, 80, *TRUE)
+    empty = np.zeros(0)
+    fine_u, fine_v = refine_at(frame0, frame1, empty, empty, empty, empty)
+    assert fine_u.shape == fine_v.shape == (0,)
+    nothing = np.full(3, np.nan)
+    fine_u, _ = refine_at(frame0, frame1, np.arange(3), np.arange(3), nothing, nothing)
+    assert np.isnan(fine_u).all()
