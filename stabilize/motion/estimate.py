@@ -102,7 +102,7 @@ def estimate_rotations(
     resumed: list[int] = []  # ... and, where unlike, how far back its picture resumes
     pictures = _noting_likeness(frames, likenesses, resumed)
     noted = _noting_texture(pictures, estimator.grid, textures, greys)
-    strides: list[tuple] = []  # each stride's (u, v, valid, measured), while it streams
+    strides: list[tuple] = []  # each stride's (u, v, valid, measured, fine u, fine v)
     if every >= 2:
         noted = _noting_strides(noted, every, backend, estimator, strides)
     # A chunk's vote runs while the next chunk's flow is computed: without the overlap,
@@ -374,9 +374,10 @@ def _noting_strides(
     strides: list[tuple],
 ) -> Iterator[NDArray]:
     """The frames as they are, the flow from each ``every``-th frame to the next such
-    sampled into ``strides`` as it streams: (u, v, valid, measured) of one pair each,
-    measured where the earlier frame has texture (one field more per ``every`` pairs;
-    only the last such frame is held)."""
+    sampled into ``strides`` as it streams: (u, v, valid, measured, fine u, fine v) of
+    one pair each, measured where the earlier frame has texture and refined there
+    (:func:`_refined`; one field more per ``every`` pairs; only the last such frame is
+    held)."""
     grid = estimator.grid
     key: NDArray | None = None
     for index, frame in enumerate(frames):
