@@ -9,6 +9,7 @@ clip, whose audio, subtitles, chapters and metadata are kept:
 from __future__ import annotations
 
 import subprocess
+import weakref
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -196,6 +197,11 @@ class FrameWriter:
         cmd += [*output_args(path, encoding, container, mux.video_delay), *colour.ffmpeg_args()]
         cmd += [*colour.hdr10_args(codec), local(path, container.pictures is not None)]
         self._process = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+        # An interrupt after this returns and before `with` takes the writer (it strikes
+        # as __enter__ starts, and a `with` whose __enter__ raised never calls __exit__)
+        # left FFmpeg running, to write its file after the caller had removed it (a test
+        # of SIGTERM found a .partial.cfr.mp4 left): the writer, once dropped, reaps it.
+        weakref.finalize(self, _reap, self._process)
         try:
             self._said = drain(self._process.stderr)  # (a damaged source's audio says much)
             widen_pipe(self._process.stdin)
@@ -246,6 +252,14 @@ class FrameWriter:
             self.close()
         else:
             self._stop()
+
+
+def _reap(process: subprocess.Popen) -> None:
+    """End an encoder still running when its writer is dropped: nothing it would write
+    is wanted (a writer closed or stopped has nothing left to reap)."""
+    if process.poll() is None:
+        process.kill()
+        process.wait()
 
 
 def encoder_message(stderr: str, code: int | None) -> str:

@@ -47,3 +47,13 @@ def test_an_interrupt_while_the_encoder_finishes_stops_it(tmp_path, monkeypatch)
         with writer:
             writer.write(np.zeros((64, 64, 3), np.uint8))
     assert kills and process.returncode is not None  # killed and reaped, not left going
+
+
+def test_an_encoder_whose_writer_is_dropped_unclosed_is_ended(tmp_path):
+    # An interrupt as `with` starts, before __exit__ is set up, drops the writer with
+    # FFmpeg still reading its pipe: it wrote the file once the caller had removed it.
+    writer = FrameWriter(tmp_path / "a.mp4", (64, 64), 30.0, container=container_for("a.mp4"))
+    process = writer._process
+    assert process.poll() is None  # waiting for frames
+    del writer
+    assert process.returncode is not None  # killed and reaped as the writer went
