@@ -251,7 +251,7 @@ def _samples(kept: list[tuple], estimator: HoughEstimator, ws: WorkingSize) -> S
         fine_v=fine_v,
         x=grid.x,
         y=grid.y,
-        rows=np.repeat(grid.rows, len(grid.cols)).astype(np.float64),
+        rows=_grid_pixels(grid)[1].astype(np.float64),
         height=ws.size[0],
         scale=ws.scale[0],
     )
@@ -339,8 +339,9 @@ def _noting_texture(
     measure flow at the sample grid (:func:`flow.texture.textured`), and in ``greys``
     the frame in grey, for its pairs' vectors to be refined (:func:`_refined`)."""
     for frame in frames:
-        textures.append(textured(frame, grid.rows, grid.cols))
-        greys.append(to_grey(frame))
+        grey = to_grey(frame)  # once: the texture's and the refinement's
+        textures.append(textured(grey, grid.rows, grid.cols))
+        greys.append(grey)
         yield frame
 
 
@@ -412,8 +413,7 @@ def _noting_likeness(
 def band_masks(estimator: HoughEstimator, height: int, bands: int) -> list[NDArray]:
     """Which sample vectors vote for each of ``bands`` horizontal bands (those whose
     row lies in it); every vector votes for the whole frame."""
-    grid = estimator.grid
-    rows = np.repeat(grid.rows, len(grid.cols))
+    rows = _grid_pixels(estimator.grid)[1]
     edges = np.linspace(0, height, bands + 1).round().astype(int)
     return [(rows >= edges[b - 1]) & (rows < edges[b]) for b in range(1, bands + 1)]
 
