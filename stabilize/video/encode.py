@@ -241,8 +241,7 @@ class FrameWriter:
 
     def _stop(self) -> None:
         """End the encoder at once and reap it: nothing it would write is wanted."""
-        self._process.kill()
-        self._process.wait()
+        _reap(self._process)
 
     def __enter__(self) -> FrameWriter:
         return self
