@@ -32,8 +32,8 @@ the median ratio is then given of the means too. With ``--sizes`` each output is
 so at the registration's four other sizes (576–704 px on the long side, not 640 only):
 20 readings, whose mean no longer carries the offset of where the pyramid's grid falls
 on the content (±3% on hero7). (The figures quoted here were read before
-the registration was refined to a fraction of a pixel, on 7 December; the README's
-real-footage section gives the bench read both ways.)
+the registration was refined to a fraction of a pixel, on 7 December; docs/real-footage.md
+gives that day's bench read both ways, and the README the current run.)
 
 ``--out-crf`` sets the CRF both tools' output (and the crop) is encoded at (18, as our
 default encodes it). At 0 the encode is lossless and the rows read the geometry alone:
