@@ -52,9 +52,10 @@ def runs(jello, tmp_path_factory) -> dict:
     folder = tmp_path_factory.mktemp("runs")
     out = {}
     for name, settings in (("whole", WHOLE), ("off", OFF)):
-        summary, planned = stabilize_video(jello, folder / f"{name}.mp4", settings)
-        read = measured if name == "whole" else lambda _, output: alone(output)
-        out[name] = (summary, planned, read(jello, folder / f"{name}.mp4"))
+        output = folder / f"{name}.mp4"
+        summary, planned = stabilize_video(jello, output, settings)
+        read = measured(jello, output) if name == "whole" else alone(output)
+        out[name] = (summary, planned, read)
     return out
 
 
