@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.video.binary import drain, ffmpeg_exe, local, widen_pipe
+from stabilize.video.binary import drain, ffmpeg_exe, interrupts_held, local, widen_pipe
 from stabilize.video.colour import UNKNOWN, Colour
 from stabilize.video.containers import Container, container_for
 from stabilize.video.encoders import (
@@ -196,17 +196,22 @@ class FrameWriter:
         codec = encoding.codec_for(container)
         cmd += [*output_args(path, encoding, container, mux.video_delay), *colour.ffmpeg_args()]
         cmd += [*colour.hdr10_args(codec), local(path, container.pictures is not None)]
-        self._process = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
-        # An interrupt after this returns and before `with` takes the writer (it strikes
-        # as __enter__ starts, and a `with` whose __enter__ raised never calls __exit__)
-        # left FFmpeg running, to write its file after the caller had removed it (a test
-        # of SIGTERM found a .partial.cfr.mp4 left): the writer, once dropped, reaps it.
-        weakref.finalize(self, _reap, self._process)
+        process = None
         try:
-            self._said = drain(self._process.stderr)  # (a damaged source's audio says much)
-            widen_pipe(self._process.stdin)
+            with interrupts_held():  # one inside Popen left FFmpeg running, unowned
+                process = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+            self._process = process
+            # An interrupt after this returns and before `with` takes the writer (it
+            # strikes as __enter__ starts, and a `with` whose __enter__ raised never calls
+            # __exit__) left FFmpeg running, to write its file after the caller had
+            # removed it (a test of SIGTERM found a .partial.cfr.mp4 left): the writer,
+            # once dropped, reaps it.
+            weakref.finalize(self, _reap, process)
+            self._said = drain(process.stderr)  # (a damaged source's audio says much)
+            widen_pipe(process.stdin)
         except BaseException:  # an interrupt before `with` takes it: FFmpeg left running
-            self._stop()  # wrote its file after the caller had removed it
+            if process is not None:
+                _reap(process)  # wrote its file after the caller had removed it
             raise
 
     def write(self, frame: NDArray[np.uint8]) -> None:
