@@ -36,7 +36,7 @@ from stabilize.motion.cuts import Breaks, said_cuts, track_breaks
 from stabilize.motion.estimate import READOUT_BANDS, Damaged
 from stabilize.motion.focal import FocalChoice, estimate_motion
 from stabilize.motion.repair import repair_track
-from stabilize.motion.residual import reexpress
+from stabilize.motion.residual import gate_px, reexpress
 from stabilize.motion.track import VisualTrack
 from stabilize.path.plan import plan_path
 from stabilize.path.residual import MOTION_MODELS
@@ -440,6 +440,7 @@ def _rotations(
                 rolling.frames(first, pairs + 1),
                 px,
                 job.info.height,
+                gate_px(track.times),
             )
             for first, pairs, px in _pair_segments(segments, len(R))
         ]

@@ -44,7 +44,7 @@ from rotation import HoughEstimator
 from rotation.camera import scale_intrinsics
 from rotation.sampling import SampleGrid
 from stabilize.motion.cuts import ALIKE, RESUME, likeness, resumes_from, thumbnail
-from stabilize.motion.residual import residual_motion
+from stabilize.motion.residual import gate_px, residual_motion
 from stabilize.motion.track import Samples, VisualTrack, mean_rows
 from stabilize.progress import Progress, no_progress
 from stabilize.settings import Settings
@@ -91,6 +91,7 @@ def estimate_rotations(
     backend = flow.get(settings.flow, **settings.flow_options)
     estimator, frames = _estimator_and_frames(path, info, settings, ws, lens)
     voted = 0 if settle else bands  # the bands voted in the stream, so far
+    gate = gate_px(times)  # what the rotation may leave on the background
     keeping = keep_samples or settle is not None
     found: list[list[tuple]] = [[] for _ in range(voted + 1)]  # whole frame, then bands
     kept: list[tuple] = []
@@ -125,11 +126,11 @@ def estimate_rotations(
                 chosen = settle.choose(so_far)
                 if chosen is not None:
                     estimator, voted, masks = chosen, bands, band_masks(chosen, ws.size[0], bands)
-                    found, residual = _revoted(estimator, so_far.samples, masks)
+                    found, residual = _revoted(estimator, so_far.samples, masks, gate)
                     keeping = keep_samples
                     kept = kept if keeping else []
                 settle = None
-            voting = voter.submit(_vote, estimator, u, v, valid, measured, masks, found, fine)
+            voting = voter.submit(_vote, estimator, u, v, valid, measured, masks, found, fine, gate)
             if keeping:
                 kept.append((u.astype(np.float32), v.astype(np.float32), valid, measured, *fine))
         if voting is not None:
@@ -206,7 +207,7 @@ def estimate_again(estimator: HoughEstimator, track: VisualTrack, bands: int = 0
     ``estimator`` (of the same grid: another focal length), bands too, without decoding
     anything; what the pictures said (their likeness) is kept."""
     masks = band_masks(estimator, estimator.size[0], bands)
-    found, residual = _revoted(estimator, track.samples, masks)
+    found, residual = _revoted(estimator, track.samples, masks, gate_px(track.times))
     again = _track(track.times, found, bands)
     # the likeness once went missing here, so a clip whose focal length was estimated at
     # its end (any clip under MAX_PAIRS pairs) had no cut found
@@ -222,17 +223,19 @@ def estimate_again(estimator: HoughEstimator, track: VisualTrack, bands: int = 0
 
 
 def _revoted(
-    estimator: HoughEstimator, samples: Samples, masks: list[NDArray]
+    estimator: HoughEstimator, samples: Samples, masks: list[NDArray], gate: float
 ) -> tuple[list[list[tuple]], list[NDArray]]:
     """The found (R, support, mean row) lists and the similarities left (a chunk's
-    array each) of every pair of ``samples``, voted again by ``estimator``."""
+    array each, within ``gate`` px) of every pair of ``samples``, voted again by
+    ``estimator``."""
     found: list[list[tuple]] = [[] for _ in range(len(masks) + 1)]
     residual = []
     fine_u, fine_v = samples.fine
     for part in _chunks(len(samples.u)):
         u, v, valid = samples.u[part], samples.v[part], samples.valid[part]
         fine = (fine_u[part], fine_v[part])
-        residual.append(_vote(estimator, u, v, valid, samples.voting[part], masks, found, fine))
+        voting = samples.voting[part]
+        residual.append(_vote(estimator, u, v, valid, voting, masks, found, fine, gate))
     return found, residual
 
 
@@ -447,15 +450,16 @@ def _vote(
     masks: list[NDArray],
     found: list[list[tuple]],
     fine: tuple[NDArray, NDArray],
+    gate: float,
 ) -> NDArray:
     """(R, support, mean row) of each pair into ``found``: the whole frame from the
     ``measured`` vectors, then each band (its mask in ``masks``) from its ``valid``
     ones; returns the similarity (n, 4) each whole-frame rotation leaves on the measured
-    vectors, refined (``fine``: their u, v)."""
+    vectors, refined (``fine``: their u, v), within ``gate`` px of it."""
     grid = estimator.grid
     votes = [measured, *(valid & mask for mask in masks)]
     R = np.array([est.matrix for est in _vote_sets(estimator, u, v, votes, found)[0]])
-    return residual_motion(grid.x, grid.y, *fine, measured, R, estimator.focal)
+    return residual_motion(grid.x, grid.y, *fine, measured, R, estimator.focal, gate)
 
 
 def _vote_sets(

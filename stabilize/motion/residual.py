@@ -8,7 +8,7 @@ similarity in normalised image coordinates (x/f, y/f) about the principal point,
 
     r(p) = p_{t+1} - π(R_t p_t) ≈ (dx + a·x - b·y,  dy + b·x + a·y),
 
-on every vector within ``GATE_PX`` of where the rotation puts it, by iteratively
+on every vector within the gate (:func:`gate_px`) of where the rotation puts it, by iteratively
 reweighted least squares with Cauchy weights, starting from no motion: the background
 the rotation vote found. A subject or a crowd moves further than the gate and is left
 out; where it keeps under ``MIN_SHARE`` of a pair's vectors, the background is too
@@ -37,6 +37,16 @@ CAUCHY_PX = 0.5  # px at the flow's size: the scale of the Cauchy weights
 # clips stay within their spread (karma 0.520 → 0.487), the rendered distant scenes the
 # same to 0.3%
 GATE_PX = 4.5
+# ... per this long between a pair's frames (s): a pair that spans longer widens the gate
+# in proportion, since a near surface's parallax and a subject's motion both grow with
+# the time between the frames, and the gate tells them apart. At half their rate
+# (every other frame; lossless, the means of 20 readings), at 4.5 px and at 9: hero7
+# 1.648 → 1.525 px, max-heromode 1.155 → 1.058, a rendered 100° walk 0.663 → 0.636;
+# phone-cc9's frames, their 31° crop, karma and a 70° walk within their readings'
+# noise (docs/remainder.md). At a faster rate the gate stays: from 45 fps pass 1 also
+# measures strides of about a thirtieth of a second (stabilize.motion.strides), whose
+# own times give them their gate. NTSC's 29.97 fps counts as 30
+GATE_INTERVAL_S = 1001 / 30000
 IRLS_STEPS = 5
 # The share of a pair's valid vectors the gate must keep for its roll and zoom (a, b) to
 # count: below it, a subject close to the lens likely won the vote, and its approach
@@ -45,6 +55,16 @@ IRLS_STEPS = 5
 # where `similarity` shook 18.5 px without this and 15.1 with it (0.6 cost hero7 0.07 px
 # for one pair that zoomed; taking the neighbours' zoom instead cost cockatoo 1.4 px)
 MIN_SHARE = 0.4
+
+
+def gate_px(times: NDArray) -> float:
+    """The gate (px at the flow's size) for a clip whose frames come at ``times`` (s):
+    ``GATE_PX`` for pairs ``GATE_INTERVAL_S`` apart or less, widened in proportion to
+    the median time between its frames where that is longer."""
+    steps = np.diff(np.asarray(times, np.float64))
+    steps = steps[np.isfinite(steps) & (steps > 0)]
+    interval = float(np.median(steps)) if len(steps) else GATE_INTERVAL_S
+    return GATE_PX * max(1.0, round(interval / GATE_INTERVAL_S, 3))  # (to a thousandth)
 
 
 def design(xn: NDArray, yn: NDArray) -> tuple[NDArray, NDArray]:
@@ -92,21 +112,35 @@ def normalised(rays: NDArray) -> tuple[NDArray, NDArray]:
 
 
 def residual_motion(
-    x: NDArray, y: NDArray, u: NDArray, v: NDArray, valid: NDArray, R: NDArray, focal: float
+    x: NDArray,
+    y: NDArray,
+    u: NDArray,
+    v: NDArray,
+    valid: NDArray,
+    R: NDArray,
+    focal: float,
+    gate: float = GATE_PX,
 ) -> NDArray[np.float64]:
     """Each pair's similarity (n, 4) left after its rotation: sample points (x, y) (M,)
     about the principal point, their flow u, v (n, M) where ``valid`` (n, M), rotations
-    R (n, 3, 3), in pixels at focal length ``focal``."""
+    R (n, 3, 3), in pixels at focal length ``focal``; ``gate`` (px, :func:`gate_px`)."""
     lx, ly = landing(x, y, R, focal)
-    return background_similarity(x, y, (x + u) / focal - lx, (y + v) / focal - ly, valid, focal)
+    rx, ry = (x + u) / focal - lx, (y + v) / focal - ly
+    return background_similarity(x, y, rx, ry, valid, focal, gate)
 
 
 def background_similarity(
-    x: NDArray, y: NDArray, rx: NDArray, ry: NDArray, valid: NDArray, focal: float
+    x: NDArray,
+    y: NDArray,
+    rx: NDArray,
+    ry: NDArray,
+    valid: NDArray,
+    focal: float,
+    gate: float = GATE_PX,
 ) -> NDArray[np.float64]:
     """The similarity (n, 4) of the remainders rx, ry (n, M, normalised) at points (x, y)
-    (M,, px about the principal point) that lie within ``GATE_PX`` of no motion."""
-    near = valid & (np.hypot(rx, ry) < GATE_PX / focal)
+    (M,, px about the principal point) that lie within ``gate`` px of no motion."""
+    near = valid & (np.hypot(rx, ry) < gate / focal)
     params = fit_similarity(x / focal, y / focal, rx, ry, near, CAUCHY_PX / focal)
     kept = near.sum(axis=1) >= MIN_SHARE * np.maximum(valid.sum(axis=1), 1)
     params[~kept, 2:] = 0.0  # too little background to tell its roll and zoom

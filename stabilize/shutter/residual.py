@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from stabilize.motion.residual import background_similarity, normalised
+from stabilize.motion.residual import GATE_PX, background_similarity, normalised
 from stabilize.motion.track import Samples
 from stabilize.warp.rolling import RollingShutter
 
@@ -26,10 +26,16 @@ CHUNK = 16  # pairs whose per-vector turns are held at once
 
 
 def rectified_residual(
-    samples: Samples, R: NDArray, rolling: RollingShutter, focal: float, height: int
+    samples: Samples,
+    R: NDArray,
+    rolling: RollingShutter,
+    focal: float,
+    height: int,
+    gate: float = GATE_PX,
 ) -> NDArray[np.float64]:
     """The similarity (N-1, 4) each middle-row rotation R (N-1, 3, 3) leaves, from the
-    kept ``samples``; ``focal`` (px) and ``height`` (px) of the input frames."""
+    kept ``samples``; ``focal`` (px) and ``height`` (px) of the input frames; ``gate``
+    (px at the flow's size) as pass 1's (:func:`stabilize.motion.residual.gate_px`)."""
     f = focal * samples.scale
     x, y = samples.x, samples.y
     ray = np.stack([x, y, np.full_like(x, f)], 1)
@@ -47,5 +53,5 @@ def rectified_residual(
         after = (end.swapaxes(-1, -2) @ seen[..., None])[..., 0]  # D_{k+1}(y')ᵀ p'
         turned = (R[part][:, None] @ before[..., None])[..., 0]
         (ax, ay), (tx, ty) = normalised(after), normalised(turned)
-        out.append(background_similarity(x, y, ax - tx, ay - ty, samples.voting[part], f))
+        out.append(background_similarity(x, y, ax - tx, ay - ty, samples.voting[part], f, gate))
     return np.concatenate(out) if out else np.zeros((0, 4))

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from rotation import so3
-from stabilize.motion.residual import GATE_PX, reexpress, residual_motion
+from stabilize.motion.residual import GATE_PX, gate_px, reexpress, residual_motion
 
 F = 400.0
 
@@ -37,14 +37,44 @@ def test_a_near_wall_passing_4_px_a_frame_is_background():
     """A walk's sway past a wall that fills the frame: static, so its 4 px a frame (at
     the flow's size; hero7's near plants loom about 3) is the camera's, to be undone.
     A 3 px gate left such a pair with no motion at all."""
+    dx, dy = _past_a_wall(4.0, seed=1)
+    assert dx == pytest.approx(4.0, abs=0.05) and abs(dy) < 0.05
+
+
+def _past_a_wall(shift: float, seed: int, gate: float = GATE_PX) -> tuple[float, float]:
+    """The translation (px) fitted within ``gate`` to a pair turned a little and moved
+    ``shift`` px to the right, as a wall that fills the frame moves past, with 0.2 px
+    of flow noise."""
     x, y = _grid()
     R = so3.exp_so3(np.array([0.004, -0.01, 0.0]))
-    u, v = _flow(x, y, R, (4.0, 0.0))
-    rng = np.random.default_rng(1)
+    u, v = _flow(x, y, R, (shift, 0.0))
+    rng = np.random.default_rng(seed)
     u, v = u + rng.normal(0, 0.2, u.shape), v + rng.normal(0, 0.2, v.shape)
     valid = np.ones((1, len(x)), bool)
-    dx, dy, _, _ = residual_motion(x, y, u[None], v[None], valid, R[None], F)[0]
-    assert dx * F == pytest.approx(4.0, abs=0.05) and abs(dy * F) < 0.05
+    dx, dy, _, _ = residual_motion(x, y, u[None], v[None], valid, R[None], F, gate)[0]
+    return dx * F, dy * F
+
+
+def test_the_gate_widens_with_the_time_between_frames():
+    """Parallax and a subject's motion both grow with the time a pair spans: a clip at
+    half the rate has twice of each, and its gate is twice as wide. Faster rates keep
+    the gate (strides of a thirtieth of a second measure them too)."""
+    for fps in (30.0, 30000 / 1001, 60.0, 240.0):
+        assert gate_px(np.arange(20) / fps) == GATE_PX
+    assert gate_px(np.arange(20) * 1001 / 15000) == 2 * GATE_PX  # 14.985 fps
+    assert gate_px(np.arange(20) / 20.0) == pytest.approx(GATE_PX * 30000 / 1001 / 20, abs=0.01)
+    dropped = np.delete(np.arange(40) * 1001 / 15000, [5, 17])  # the median, not a dropped frame's
+    assert gate_px(dropped) == 2 * GATE_PX
+    assert gate_px(np.zeros(5)) == GATE_PX and gate_px(np.array([0.0])) == GATE_PX
+
+
+def test_a_near_wall_at_half_the_rate_is_background_within_its_gate():
+    """The near wall's 4 px a frame at 30 fps is 8 px at 15: outside a 30 fps pair's gate,
+    where the pair's fit is left to the few vectors nearer the rotation's prediction;
+    inside the gate of a pair that spans a fifteenth of a second."""
+    dx, dy = _past_a_wall(8.0, seed=2, gate=gate_px(np.arange(10) / 15.0))
+    assert dx == pytest.approx(8.0, abs=0.05) and abs(dy) < 0.05
+    assert _past_a_wall(8.0, seed=2)[0] < 1.0  # a 30 fps pair's gate
 
 
 def test_a_crowd_moving_across_the_frame_does_not_drag_the_background():
