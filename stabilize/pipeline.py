@@ -433,6 +433,7 @@ def _rotations(
     if residual is not None and shutter is not None and rolling is not None:
         from stabilize.shutter.residual import rectified_residual
 
+        gate = gate_px(track.times)  # pass 1's
         parts = [  # each shot's pairs, and the cut after it (whose residual is none)
             rectified_residual(
                 track.samples.pairs(first, pairs),
@@ -440,7 +441,7 @@ def _rotations(
                 rolling.frames(first, pairs + 1),
                 px,
                 job.info.height,
-                gate_px(track.times),
+                gate,
             )
             for first, pairs, px in _pair_segments(segments, len(R))
         ]

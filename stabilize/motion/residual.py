@@ -26,6 +26,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from stabilize.video import frame_interval
+
 MIN_VECTORS = 24  # fewer valid vectors leave the fit to noise: no residual motion
 CAUCHY_PX = 0.5  # px at the flow's size: the scale of the Cauchy weights
 # px at the flow's size: vectors further than this from where the rotation puts them
@@ -61,10 +63,8 @@ def gate_px(times: NDArray) -> float:
     """The gate (px at the flow's size) for a clip whose frames come at ``times`` (s):
     ``GATE_PX`` for pairs ``GATE_INTERVAL_S`` apart or less, widened in proportion to
     the median time between its frames where that is longer."""
-    steps = np.diff(np.asarray(times, np.float64))
-    steps = steps[np.isfinite(steps) & (steps > 0)]
-    interval = float(np.median(steps)) if len(steps) else GATE_INTERVAL_S
-    return GATE_PX * max(1.0, round(interval / GATE_INTERVAL_S, 3))  # (to a thousandth)
+    widened = round(frame_interval(np.asarray(times)) / GATE_INTERVAL_S, 3)  # (to 0.1%)
+    return GATE_PX * max(1.0, widened)
 
 
 def design(xn: NDArray, yn: NDArray) -> tuple[NDArray, NDArray]:
